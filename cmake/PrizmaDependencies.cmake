@@ -1,0 +1,33 @@
+# Finds Prizma's dependencies as Debian 12 ships them (see docs/building.md for the traps).
+find_package(PkgConfig REQUIRED)
+find_package(Threads REQUIRED)
+
+# OpenEXR 3.1: its config warns about a missing PyImath file; harmless.
+find_package(OpenEXR CONFIG REQUIRED)
+find_package(Eigen3 3.3 CONFIG REQUIRED)
+find_package(TBB CONFIG REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)
+find_package(nlohmann_json CONFIG REQUIRED)
+
+# OpenImageIO's CMake config on Debian 12 needs OpenCV headers: use pkg-config instead.
+pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
+# OpenColorIO's config sits where find_package does not look: use pkg-config.
+pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO)
+
+# libnifti's CMake config points at a non-multiarch path: find the pieces by hand.
+find_package(ZLIB REQUIRED)
+find_path(NIFTI_INCLUDE_DIR nifti1_io.h PATH_SUFFIXES nifti REQUIRED)
+find_library(NIFTI_IO_LIBRARY niftiio REQUIRED)
+find_library(NIFTI_ZNZ_LIBRARY znz REQUIRED)
+if(NOT TARGET prizma_nifti)
+  add_library(prizma_nifti INTERFACE)
+  target_include_directories(prizma_nifti SYSTEM INTERFACE ${NIFTI_INCLUDE_DIR})
+  target_link_libraries(prizma_nifti INTERFACE ${NIFTI_IO_LIBRARY} ${NIFTI_ZNZ_LIBRARY} ZLIB::ZLIB m)
+endif()
+
+if(PRIZMA_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(PRIZMA_BUILD_BENCH)
+  find_package(benchmark REQUIRED)
+endif()

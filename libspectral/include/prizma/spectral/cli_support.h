@@ -1,0 +1,34 @@
+#pragma once
+// CLI11 glue shared by the executables (header-only; the apps link CLI11).
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <string>
+
+#include "prizma/spectral/tool_main.h"
+
+namespace prizma::spectral {
+
+// Parses argv; on --help / --version prints to stdout and returns kExitOk; on a usage error prints
+// "prog: error: <message>" and "Try 'prog --help'." to stderr and returns kExitUsage. Returns -1 when
+// parsing succeeded and the program should go on.
+inline int parse_command_line(CLI::App& app, int argc, const char* const* argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << app.help();
+    return kExitOk;
+  } catch (const CLI::CallForAllHelp&) {
+    std::cout << app.help("", CLI::AppFormatMode::All);
+    return kExitOk;
+  } catch (const CLI::CallForVersion&) {
+    std::cout << app.get_name() << " " << prizma_version() << "\n";
+    return kExitOk;
+  } catch (const CLI::ParseError& e) {
+    std::cerr << app.get_name() << ": error: " << e.what() << "\n"
+              << "Try '" << app.get_name() << " --help'.\n";
+    return kExitUsage;
+  }
+  return -1;
+}
+
+}  // namespace prizma::spectral

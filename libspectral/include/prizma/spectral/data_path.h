@@ -1,0 +1,12 @@
+#pragma once
+// Where Prizma finds data/ (CIE tables, OCIO config): $PRIZMA_DATA_DIR if set, else the source
+// tree's data/ recorded at build time, else <executable>/../share/prizma.
+#include <filesystem>
+
+namespace prizma::spectral {
+
+std::filesystem::path data_dir();
+// data_dir()/relative, throwing RuntimeError naming the path when it does not exist.
+std::filesystem::path data_file(const std::filesystem::path& relative);
+
+}  // namespace prizma::spectral

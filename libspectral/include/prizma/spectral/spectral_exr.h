@@ -1,0 +1,72 @@
+#pragma once
+// The spectral OpenEXR layout (docs/spectral-exr.md; Fichet, Pacanowski, Wilkie, JCGT 2021):
+// reflective channels T.<centre>nm, one layer per light (<light>.T.<centre>nm) when there are two
+// or more lights, exact bin edges and provenance in prizma: attributes.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "prizma/spectral/bin_layout.h"
+
+namespace prizma::spectral {
+
+struct SpectralExrInfo {
+  std::string lights_json;       // prizma:lights (JSON array of {name, direction, angularSizeDeg, spectrum})
+  std::int64_t samples = 0;      // prizma:samples, samples per pixel in this file
+  std::string sample_range;      // prizma:sampleRange "A:B"
+  std::int64_t seed = 0;         // prizma:seed
+  std::string scene_hash;        // prizma:sceneHash
+  std::string version;           // prizma:version
+  std::string wavelength_sampling;  // prizma:wavelengthSampling
+  bool is_prizma = false;        // read: the file carried prizma: attributes
+};
+
+// One light's transport: width·height·bins floats, pixel-major, bins contiguous:
+// value(x, y, i) = data[(y·width + x)·bins + i].
+struct TransportLayer {
+  std::string name;              // light name; letters, digits, '_' and '-'
+  std::vector<float> data;
+  std::vector<float> variance;   // empty or same size: per-pixel variance of the mean
+};
+
+struct SpectralImage {
+  int width = 0;
+  int height = 0;
+  BinLayout bins;
+  std::vector<TransportLayer> lights;  // at least one
+  SpectralExrInfo info;
+
+  std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
+  // Index of the light with this name, or -1.
+  int find_light(std::string_view name) const;
+};
+
+enum class ExrPixelType {
+  Float,  // default
+  Half,   // only on request; values beyond half's range are refused (or clamped, see below)
+};
+
+struct ExrWriteOptions {
+  ExrPixelType pixel_type = ExrPixelType::Float;
+  // With Half: clamp values above 65504 and warn on stderr, instead of refusing.
+  bool clamp_half = false;
+  bool write_variance = true;  // write var layers where present
+};
+
+// Writes atomically (temporary file in the same folder, then rename): a failure never leaves a partial
+// file and never destroys an existing one. Throws InputError for invalid images (NaN, names),
+// RuntimeError for I/O failures, naming the path.
+void write_spectral_exr(const std::filesystem::path& path, const SpectralImage& image,
+                        const ExrWriteOptions& opts = {});
+
+// Reads a Prizma file or any conforming single-layer reflective spectral EXR (bin edges then derived
+// at midpoints between centres, first and last bins mirrored). Throws InputError naming the path
+// for files that are not EXR, truncated, emissive-only, without spectral channels, or with
+// inconsistent edges and centres.
+SpectralImage read_spectral_exr(const std::filesystem::path& path);
+
+// "T.550,000000nm" style channel name for a wavelength (six decimals, comma separator).
+std::string spectral_channel_name(double lambda_nm, std::string_view layer = "");
+
+}  // namespace prizma::spectral
