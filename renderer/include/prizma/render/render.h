@@ -1,0 +1,84 @@
+#pragma once
+// render(): the spectral volume path tracer, from a validated Scene to a SpectralImage holding, per
+// pixel, per light and per bin, the bin-averaged radiance under that light at unit white spectrum
+// (docs/renderer.md). merge_shards() combines renders of disjoint sample ranges; write_preview()
+// relights a transport image with each light's default spectrum into an 8-bit sRGB PNG.
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "prizma/render/scene.h"
+#include "prizma/spectral/spectral_exr.h"
+
+namespace prizma::render {
+
+// Reported after every pass (a block of samples over the whole image).
+struct RenderProgress {
+  std::int64_t samples_done = 0;   // samples per pixel completed so far (in this call)
+  std::int64_t samples_total = 0;  // samples per pixel this call will take if not cancelled
+  std::int64_t paths = 0;          // camera paths traced so far
+  double elapsed_seconds = 0.0;
+};
+
+struct RenderCallbacks {
+  // Called from the calling thread between passes; may be empty.
+  std::function<void(const RenderProgress&)> progress;
+  // When set and true at the end of a pass, render() stops and returns the completed passes: a
+  // valid image with a true, uniform sample count (info.samples, info.sampleRange shortened).
+  const std::atomic<bool>* cancel = nullptr;
+  // Samples per pixel per pass; 0 = automatic (about 2^22 paths per pass, at least 1 sample).
+  std::int64_t samples_per_pass = 0;
+};
+
+struct RenderStats {
+  std::int64_t paths = 0;               // camera samples taken (including rays that miss the volume)
+  std::int64_t paths_in_volume = 0;     // samples whose camera ray hit the volume's bounds
+  std::int64_t collisions = 0;          // real + null collisions of free-flight sampling
+  std::int64_t shadow_steps = 0;        // ratio-tracking steps of next-event estimation
+  std::int64_t majorant_cells = 0;      // macrocells visited by DDA traversals
+  std::int64_t nan_or_inf_count = 0;    // samples dropped because a value was not finite
+  std::int64_t samples_completed = 0;   // samples per pixel in the result (sample_end' − sample_begin)
+  std::int64_t pixels_converged = 0;    // pixels stopped early by target_error
+  bool interrupted = false;             // the cancel flag stopped the render early
+  bool wavelength_independent = false;  // the medium was traced once per path for all bins
+  double wall_seconds = 0.0;
+};
+
+// Renders scene.settings' sample range of every pixel. Deterministic: a pure function of the scene,
+// the seed and the sample range, independent of thread count (settings.threads: 0 = all cores).
+// Throws InputError for settings it cannot render (empty bins, sample_end ≤ sample_begin, no lights).
+spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callbacks = {},
+                               RenderStats* stats = nullptr);
+
+// Combines renders of disjoint sample ranges of the same scene into the render of their union
+// (weighted by sample counts; variance layers combined when all shards carry them). Throws
+// InputError (input "merge") for an empty list, different scene hash, seed, bins, size, lights or
+// wavelength sampling, or overlapping sample ranges. Ranges need not be contiguous; the result's
+// sampleRange is "min:max" when they are and lists them ("0:8,16:24") otherwise.
+spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards);
+
+// The scene's lights in the JSON form stored in prizma:lights.
+std::string lights_to_json(const std::vector<Light>& lights);
+// Lights back from an image's prizma:lights (names, directions, default spectra); lights missing
+// from the JSON (foreign files) get the layer name, the environment direction and "D65".
+std::vector<Light> lights_from_image(const spectral::SpectralImage& image);
+
+struct PreviewOptions {
+  double exposure_ev = 0.0;  // linear scale 2^exposure_ev before encoding
+  std::filesystem::path spectrum_base_dir;  // csv: spectra resolve against this folder
+};
+
+// Relights every light with its default spectrum (relative to white, summed over lights), converts
+// XYZ → linear sRGB → sRGB-encoded 8-bit and writes a PNG (or any OpenImageIO format by extension)
+// atomically. Throws InputError for an unknown spectrum spec, RuntimeError for I/O failures.
+void write_preview(const std::filesystem::path& path, const spectral::SpectralImage& image,
+                   const std::vector<Light>& lights, const PreviewOptions& opts = {});
+
+// "spectral-tracking" / "single", as stored in prizma:wavelengthSampling and taken by the CLI.
+std::string wavelength_sampling_name(WavelengthSampling w);
+WavelengthSampling parse_wavelength_sampling(std::string_view name, std::string_view input = "wavelength sampling");
+
+}  // namespace prizma::render
