@@ -1,0 +1,583 @@
+// load_scene: the JSON scene file (docs/scene-format.md) → a validated Scene. Every error is an
+// InputError whose input is "<file>: <field path>".
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "prizma/render/scene.h"
+#include "prizma/render/transfer_function.h"
+#include "prizma/render/volume.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/spectrum_spec.h"
+
+namespace prizma::render {
+
+using nlohmann::json;
+using spectral::InputError;
+using spectral::Spectrum;
+
+namespace {
+
+constexpr int kDefaultResolution = 128;
+constexpr int kMaxImageSide = 16384;
+constexpr std::size_t kMaxLightNameLength = 64;
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// Reading JSON with a field path for every message.
+class Reader {
+ public:
+  Reader(std::string file, std::filesystem::path base_dir) : m_file(std::move(file)), m_base(std::move(base_dir)) {}
+
+  const std::string& file() const { return m_file; }
+  const std::filesystem::path& base_dir() const { return m_base; }
+  std::string input(const std::string& path) const { return path.empty() ? m_file : m_file + ": " + path; }
+
+  [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
+    throw InputError(input(path), reason);
+  }
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+  static std::string index(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
+
+  static std::string describe(const json& j) {
+    std::string text = j.dump();
+    if (text.size() > 40) text = text.substr(0, 37) + "...";
+    return std::string(j.type_name()) + " " + text;
+  }
+
+  void expect_object(const json& j, const std::string& path, std::initializer_list<const char*> known) const {
+    if (!j.is_object()) fail(path, "must be an object (got " + describe(j) + ")");
+    for (const auto& [key, value] : j.items()) {
+      if (std::none_of(known.begin(), known.end(), [&](const char* k) { return key == k; })) {
+        std::string list;
+        for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+        fail(join(path, key), "unknown field (known: " + list + ")");
+      }
+    }
+  }
+
+  double number(const json& j, const std::string& path) const {
+    if (!j.is_number()) fail(path, "must be a number (got " + describe(j) + ")");
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) fail(path, "must be finite");
+    return v;
+  }
+  std::int64_t integer(const json& j, const std::string& path, std::int64_t lo, std::int64_t hi) const {
+    if (!j.is_number_integer()) fail(path, "must be an integer (got " + describe(j) + ")");
+    if (j.is_number_unsigned() && j.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX)) {
+      fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + j.dump() + ")");
+    }
+    const std::int64_t v = j.get<std::int64_t>();
+    if (v < lo || v > hi) {
+      fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(v) + ")");
+    }
+    return v;
+  }
+  std::string string(const json& j, const std::string& path) const {
+    if (!j.is_string()) fail(path, "must be a string (got " + describe(j) + ")");
+    return j.get<std::string>();
+  }
+  std::array<double, 3> vec3(const json& j, const std::string& path) const {
+    if (!j.is_array() || j.size() != 3) fail(path, "must be an array of 3 numbers (got " + describe(j) + ")");
+    return {number(j[0], index(path, 0)), number(j[1], index(path, 1)), number(j[2], index(path, 2))};
+  }
+  double positive(const json& j, const std::string& path) const {
+    const double v = number(j, path);
+    if (!(v > 0.0)) fail(path, "must be > 0 (got " + num(v) + ")");
+    return v;
+  }
+
+  // A file path relative to the scene's folder.
+  std::filesystem::path file_path(const json& j, const std::string& path) const {
+    const std::string s = string(j, path);
+    if (s.empty()) fail(path, "must not be empty");
+    const std::filesystem::path p(s);
+    return p.is_absolute() ? p : m_base / p;
+  }
+
+  // A spectrum: a spec string, a number, or {"spectrum": SPEC, "scale": number}.
+  Spectrum spectrum(const json& j, const std::string& path) const {
+    if (j.is_number()) return Spectrum::constant(number(j, path));
+    if (j.is_string()) {
+      spectral::SpecContext ctx;
+      ctx.input = input(path);
+      ctx.base_dir = m_base;
+      return spectral::parse_spectrum(j.get<std::string>(), ctx);
+    }
+    if (j.is_object()) {
+      expect_object(j, path, {"spectrum", "scale"});
+      if (!j.contains("spectrum")) fail(join(path, "spectrum"), "is required");
+      const json& inner = j.at("spectrum");
+      if (!inner.is_string() && !inner.is_number()) {
+        fail(join(path, "spectrum"), "must be a spectrum spec string or a number (got " + describe(inner) + ")");
+      }
+      Spectrum s = spectrum(inner, join(path, "spectrum"));
+      if (j.contains("scale")) s = s.scaled(positive(j.at("scale"), join(path, "scale")));
+      return s;
+    }
+    fail(path, "must be a spectrum spec string, a number or {\"spectrum\": SPEC, \"scale\": number} (got " +
+                   describe(j) + ")");
+  }
+
+ private:
+  std::string m_file;
+  std::filesystem::path m_base;
+};
+
+// 64-bit FNV-1a.
+class Fnv1a {
+ public:
+  void add(const void* data, std::size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) {
+      m_h ^= p[i];
+      m_h *= 0x100000001b3ULL;
+    }
+  }
+  void add_spectrum(const Spectrum& s) {
+    const double c = s.is_constant() ? s.eval(0.0) : 0.0;
+    add(&c, sizeof c);
+    add(s.wavelengths_nm().data(), s.wavelengths_nm().size() * sizeof(double));
+    add(s.values().data(), s.values().size() * sizeof(double));
+  }
+  std::string hex() const {
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(m_h));
+    return buf;
+  }
+
+ private:
+  std::uint64_t m_h = 0xcbf29ce484222325ULL;
+};
+
+Volume read_volume(const Reader& rd, const json& j) {
+  const std::string path = "volume";
+  if (!j.is_object()) rd.fail(path, "must be an object (got " + Reader::describe(j) + ")");
+  if (!j.contains("type")) rd.fail(Reader::join(path, "type"), "is required (raw, nifti or procedural)");
+  const std::string type = rd.string(j.at("type"), Reader::join(path, "type"));
+  Volume vol;
+  bool spacing_given = j.contains("spacing");
+  std::array<double, 3> spacing{1.0, 1.0, 1.0};
+  if (spacing_given) {
+    const std::string sp = Reader::join(path, "spacing");
+    spacing = rd.vec3(j.at("spacing"), sp);
+    for (int a = 0; a < 3; ++a) {
+      if (!(spacing[a] > 0.0)) rd.fail(Reader::index(sp, a), "must be > 0 (got " + num(spacing[a]) + ")");
+    }
+  }
+  if (type == "procedural") {
+    rd.expect_object(j, path, {"type", "name", "resolution", "spacing"});
+    if (!j.contains("name")) rd.fail(Reader::join(path, "name"), "is required");
+    const std::string name = rd.string(j.at("name"), Reader::join(path, "name"));
+    const auto names = procedural_volume_names();
+    if (std::find(names.begin(), names.end(), name) == names.end()) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      rd.fail(Reader::join(path, "name"), "unknown procedural volume \"" + name + "\" (known: " + list + ")");
+    }
+    const int res = j.contains("resolution")
+                        ? static_cast<int>(rd.integer(j.at("resolution"), Reader::join(path, "resolution"), 2, 2048))
+                        : kDefaultResolution;
+    vol = make_procedural_volume(name, res);
+  } else if (type == "raw") {
+    rd.expect_object(j, path, {"type", "path", "dims", "voxel_type", "endianness", "spacing"});
+    if (!j.contains("path")) rd.fail(Reader::join(path, "path"), "is required");
+    RawVolumeSpec spec;
+    spec.path = rd.file_path(j.at("path"), Reader::join(path, "path"));
+    if (j.contains("dims")) {
+      const std::string dp = Reader::join(path, "dims");
+      const json& d = j.at("dims");
+      if (!d.is_array() || d.size() != 3) rd.fail(dp, "must be an array of 3 integers (got " + Reader::describe(d) + ")");
+      for (int a = 0; a < 3; ++a) spec.dims[a] = static_cast<int>(rd.integer(d[a], Reader::index(dp, a), 1, INT32_MAX));
+    }
+    if (j.contains("voxel_type")) {
+      const std::string tp = Reader::join(path, "voxel_type");
+      const std::string t = rd.string(j.at("voxel_type"), tp);
+      if (t == "uint8" || t == "u8") spec.type = VoxelType::U8;
+      else if (t == "uint16" || t == "u16") spec.type = VoxelType::U16;
+      else if (t == "int16" || t == "i16") spec.type = VoxelType::I16;
+      else if (t == "float32" || t == "f32") spec.type = VoxelType::F32;
+      else rd.fail(tp, "unknown voxel type \"" + t + "\" (known: uint8, uint16, int16, float32, u8, u16, i16, f32)");
+      spec.type_given = true;
+    }
+    if (j.contains("endianness")) {
+      const std::string ep = Reader::join(path, "endianness");
+      const std::string e = rd.string(j.at("endianness"), ep);
+      if (e == "big") spec.big_endian = true;
+      else if (e != "little") rd.fail(ep, "must be \"little\" or \"big\" (got \"" + e + "\")");
+    }
+    spec.spacing = spacing;
+    vol = load_raw_volume(spec);
+  } else if (type == "nifti") {
+    rd.expect_object(j, path, {"type", "path", "spacing"});
+    if (!j.contains("path")) rd.fail(Reader::join(path, "path"), "is required");
+    vol = load_nifti_volume(rd.file_path(j.at("path"), Reader::join(path, "path")));
+  } else {
+    rd.fail(Reader::join(path, "type"), "must be \"raw\", \"nifti\" or \"procedural\" (got \"" + type + "\")");
+  }
+  if (spacing_given) vol.spacing = spacing;
+  return vol;
+}
+
+ValueNormalisation read_normalisation(const Reader& rd, const json& root, const Volume& vol) {
+  if (!root.contains("normalisation")) return auto_normalisation(vol);
+  const json& j = root.at("normalisation");
+  const std::string path = "normalisation";
+  if (j.is_string()) {
+    if (j.get<std::string>() != "auto") rd.fail(path, "must be \"auto\" or {\"min\": number, \"max\": number} (got " + j.dump() + ")");
+    return auto_normalisation(vol);
+  }
+  rd.expect_object(j, path, {"min", "max"});
+  if (!j.contains("min")) rd.fail(Reader::join(path, "min"), "is required");
+  if (!j.contains("max")) rd.fail(Reader::join(path, "max"), "is required");
+  ValueNormalisation n;
+  n.min = rd.number(j.at("min"), Reader::join(path, "min"));
+  n.max = rd.number(j.at("max"), Reader::join(path, "max"));
+  if (!(n.max > n.min)) rd.fail(Reader::join(path, "max"), "must be > min (got " + num(n.max) + " ≤ " + num(n.min) + ")");
+  return n;
+}
+
+TransferFunction read_materials(const Reader& rd, const json& j, const ValueNormalisation& norm) {
+  const std::string path = "materials";
+  if (!j.is_array()) rd.fail(path, "must be an array of materials (got " + Reader::describe(j) + ")");
+  if (j.empty()) rd.fail(path, "must have at least one material");
+  if (j.size() > 65534) rd.fail(path, "at most 65534 materials are supported (got " + std::to_string(j.size()) + ")");
+  const double inf = std::numeric_limits<double>::infinity();
+  TransferFunction tf;
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const std::string mp = Reader::index(path, i);
+    const json& mj = j[i];
+    rd.expect_object(mj, mp, {"name", "range", "units", "albedo", "extinction", "anisotropy", "density"});
+    Material m;
+    m.name = mj.contains("name") ? rd.string(mj.at("name"), Reader::join(mp, "name")) : "material" + std::to_string(i);
+    if (m.name.empty()) rd.fail(Reader::join(mp, "name"), "must not be empty");
+    if (!names.insert(m.name).second) rd.fail(Reader::join(mp, "name"), "duplicate material name \"" + m.name + "\"");
+
+    // Units of the range and the density ramp's values.
+    bool normalised = false;
+    if (mj.contains("units")) {
+      const std::string up = Reader::join(mp, "units");
+      const std::string u = rd.string(mj.at("units"), up);
+      if (u == "normalised" || u == "normalized") normalised = true;
+      else if (u != "raw") rd.fail(up, "must be \"raw\" or \"normalised\" (got \"" + u + "\")");
+    }
+    auto to_raw = [&](double v, bool is_lo) {
+      if (!normalised) return v;
+      // Values clamp to [0, 1] when normalised, so the ends reach past the normalisation range.
+      if (is_lo && v <= 0.0) return -inf;
+      if (!is_lo && v >= 1.0) return inf;
+      return norm.from_unit(v);
+    };
+
+    MaterialRule rule;
+    rule.material = static_cast<int>(i);
+    if (mj.contains("range")) {
+      const std::string rp = Reader::join(mp, "range");
+      const json& r = mj.at("range");
+      if (!r.is_array() || r.size() != 2) rd.fail(rp, "must be [lo, hi] (got " + Reader::describe(r) + ")");
+      const double lo = rd.number(r[0], Reader::index(rp, 0));
+      const double hi = rd.number(r[1], Reader::index(rp, 1));
+      if (!(lo <= hi)) rd.fail(rp, "lo must be ≤ hi (got [" + num(lo) + ", " + num(hi) + "])");
+      if (normalised && (lo < 0.0 || hi > 1.0)) {
+        rd.fail(rp, "normalised values must be in [0, 1] (got [" + num(lo) + ", " + num(hi) + "])");
+      }
+      rule.value_lo = to_raw(lo, true);
+      rule.value_hi = to_raw(hi, false);
+    }
+
+    const std::string ap = Reader::join(mp, "albedo");
+    const std::string ep = Reader::join(mp, "extinction");
+    if (!mj.contains("albedo")) rd.fail(ap, "is required");
+    if (!mj.contains("extinction")) rd.fail(ep, "is required");
+    m.albedo = rd.spectrum(mj.at("albedo"), ap);
+    m.sigma_t_per_unit = rd.spectrum(mj.at("extinction"), ep);
+    m.anisotropy = mj.contains("anisotropy") ? rd.spectrum(mj.at("anisotropy"), Reader::join(mp, "anisotropy"))
+                                             : Spectrum::constant(0.0);
+    validate_material(m, rd.input(mp));
+
+    if (mj.contains("density")) {
+      const std::string dp = Reader::join(mp, "density");
+      const json& d = mj.at("density");
+      if (d.is_number()) {
+        const double v = rd.number(d, dp);
+        if (v < 0.0) rd.fail(dp, "must be ≥ 0 (got " + num(v) + ")");
+        rule.density.values = {0.0};
+        rule.density.densities = {v};
+      } else {
+        if (!d.is_array() || d.empty()) {
+          rd.fail(dp, "must be a number or [[value, density], …] with at least one point (got " + Reader::describe(d) + ")");
+        }
+        for (std::size_t k = 0; k < d.size(); ++k) {
+          const std::string pp = Reader::index(dp, k);
+          if (!d[k].is_array() || d[k].size() != 2) rd.fail(pp, "must be [value, density] (got " + Reader::describe(d[k]) + ")");
+          double v = rd.number(d[k][0], Reader::index(pp, 0));
+          const double dens = rd.number(d[k][1], Reader::index(pp, 1));
+          if (dens < 0.0) rd.fail(Reader::index(pp, 1), "must be ≥ 0 (got " + num(dens) + ")");
+          if (normalised) v = norm.from_unit(v);
+          if (!rule.density.values.empty() && !(v > rule.density.values.back())) {
+            rd.fail(Reader::index(pp, 0), "values must be strictly increasing (got " + d[k][0].dump() + " after " +
+                                              d[k - 1][0].dump() + ")");
+          }
+          rule.density.values.push_back(v);
+          rule.density.densities.push_back(dens);
+        }
+      }
+    }
+    tf.materials.push_back(std::move(m));
+    tf.rules.push_back(std::move(rule));
+  }
+  return tf;
+}
+
+TransferFunction read_tf_image(const Reader& rd, const json& j, const ValueNormalisation& norm) {
+  const std::string path = "transfer_function";
+  rd.expect_object(j, path, {"image", "extinction_scale", "wavelength_range_nm"});
+  if (!j.contains("image")) rd.fail(Reader::join(path, "image"), "is required");
+  if (!j.contains("extinction_scale")) rd.fail(Reader::join(path, "extinction_scale"), "is required");
+  const auto image = rd.file_path(j.at("image"), Reader::join(path, "image"));
+  const double scale = rd.positive(j.at("extinction_scale"), Reader::join(path, "extinction_scale"));
+  double lo = 400.0;
+  double hi = 700.0;
+  if (j.contains("wavelength_range_nm")) {
+    const std::string wp = Reader::join(path, "wavelength_range_nm");
+    const json& w = j.at("wavelength_range_nm");
+    if (!w.is_array() || w.size() != 2) rd.fail(wp, "must be [lo, hi] in nm (got " + Reader::describe(w) + ")");
+    lo = rd.number(w[0], Reader::index(wp, 0));
+    hi = rd.number(w[1], Reader::index(wp, 1));
+    if (!(lo < hi) || lo < spectral::BinLayout::kMinNm || hi > spectral::BinLayout::kMaxNm) {
+      rd.fail(wp, "must be increasing within [360, 830] nm (got [" + num(lo) + ", " + num(hi) + "])");
+    }
+  }
+  return read_transfer_function_image(image, scale, lo, hi, norm, rd.input(Reader::join(path, "image")));
+}
+
+Camera read_camera(const Reader& rd, const json& j) {
+  const std::string path = "camera";
+  rd.expect_object(j, path, {"type", "position", "look_at", "up", "fov_deg", "ortho_height", "width", "height"});
+  Camera c;
+  if (j.contains("type")) {
+    const std::string tp = Reader::join(path, "type");
+    const std::string t = rd.string(j.at("type"), tp);
+    if (t == "perspective") c.type = CameraType::Perspective;
+    else if (t == "orthographic") c.type = CameraType::Orthographic;
+    else rd.fail(tp, "must be \"perspective\" or \"orthographic\" (got \"" + t + "\")");
+  }
+  auto vec = [&](const char* key, Eigen::Vector3d& out) {
+    if (!j.contains(key)) return;
+    const auto v = rd.vec3(j.at(key), Reader::join(path, key));
+    out = Eigen::Vector3d(v[0], v[1], v[2]);
+  };
+  vec("position", c.position);
+  vec("look_at", c.look_at);
+  vec("up", c.up);
+  const Eigen::Vector3d forward = c.look_at - c.position;
+  if (!(forward.norm() > 1e-9)) rd.fail(Reader::join(path, "look_at"), "must differ from position");
+  if (!(c.up.norm() > 1e-9)) rd.fail(Reader::join(path, "up"), "must not be the zero vector");
+  if (!(forward.normalized().cross(c.up.normalized()).norm() > 1e-6)) {
+    rd.fail(Reader::join(path, "up"), "must not be parallel to the view direction");
+  }
+  if (j.contains("fov_deg")) {
+    const std::string fp = Reader::join(path, "fov_deg");
+    c.fov_y_deg = rd.number(j.at("fov_deg"), fp);
+    if (!(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0)) rd.fail(fp, "must be in (0, 180) (got " + num(c.fov_y_deg) + ")");
+  }
+  if (j.contains("ortho_height")) c.ortho_height = rd.positive(j.at("ortho_height"), Reader::join(path, "ortho_height"));
+  if (j.contains("width")) c.width = static_cast<int>(rd.integer(j.at("width"), Reader::join(path, "width"), 1, kMaxImageSide));
+  if (j.contains("height")) c.height = static_cast<int>(rd.integer(j.at("height"), Reader::join(path, "height"), 1, kMaxImageSide));
+  return c;
+}
+
+// A relative csv: path in a light's spec resolves against the scene folder now, so the stored spec
+// works from any working directory.
+std::string absolute_spec(const std::string& spec, const std::filesystem::path& base) {
+  if (spec.rfind("csv:", 0) != 0) return spec;
+  const std::size_t star = spec.find('*');
+  const std::string file = spec.substr(4, star == std::string::npos ? std::string::npos : star - 4);
+  const std::filesystem::path p(file);
+  if (p.is_absolute() || base.empty()) return spec;
+  return "csv:" + (base / p).string() + (star == std::string::npos ? "" : spec.substr(star));
+}
+
+std::vector<Light> read_lights(const Reader& rd, const json& j) {
+  const std::string path = "lights";
+  if (!j.is_array()) rd.fail(path, "must be an array of lights (got " + Reader::describe(j) + ")");
+  if (j.empty()) rd.fail(path, "must have at least one light");
+  std::vector<Light> lights;
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const std::string lp = Reader::index(path, i);
+    const json& lj = j[i];
+    rd.expect_object(lj, lp, {"name", "direction", "spectrum", "angular_size_deg"});
+    Light l;
+    const std::string np = Reader::join(lp, "name");
+    if (!lj.contains("name")) rd.fail(np, "is required");
+    l.name = rd.string(lj.at("name"), np);
+    if (l.name.empty() || l.name.size() > kMaxLightNameLength) {
+      rd.fail(np, "must have 1 to " + std::to_string(kMaxLightNameLength) + " characters (got \"" + l.name + "\")");
+    }
+    for (char ch : l.name) {
+      if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-')) {
+        rd.fail(np, "may hold only letters, digits, '_' and '-' (got \"" + l.name + "\")");
+      }
+    }
+    if (!names.insert(l.name).second) rd.fail(np, "duplicate light name \"" + l.name + "\"");
+    const std::string dp = Reader::join(lp, "direction");
+    if (!lj.contains("direction")) rd.fail(dp, "is required ([0, 0, 0] = uniform environment)");
+    const auto d = rd.vec3(lj.at("direction"), dp);
+    l.direction = Eigen::Vector3d(d[0], d[1], d[2]);
+    if (l.direction.norm() > 0.0) l.direction.normalize();
+    if (lj.contains("angular_size_deg")) {
+      const std::string ap = Reader::join(lp, "angular_size_deg");
+      l.angular_size_deg = rd.number(lj.at("angular_size_deg"), ap);
+      if (!(l.angular_size_deg >= 0.0 && l.angular_size_deg < 180.0)) {
+        rd.fail(ap, "must be in [0, 180) (got " + num(l.angular_size_deg) + ")");
+      }
+      if (l.angular_size_deg > 0.0 && l.direction.norm() == 0.0) {
+        rd.fail(ap, "applies to directional lights only (this light is the environment)");
+      }
+    }
+    if (lj.contains("spectrum")) {
+      const std::string sp = Reader::join(lp, "spectrum");
+      l.spectrum_spec = rd.string(lj.at("spectrum"), sp);
+      rd.spectrum(lj.at("spectrum"), sp);  // validate now
+      l.spectrum_spec = absolute_spec(l.spectrum_spec, rd.base_dir());
+    }
+    lights.push_back(std::move(l));
+  }
+  return lights;
+}
+
+void read_settings(const Reader& rd, const json& root, RenderSettings& s) {
+  if (root.contains("bins")) {
+    s.bins = spectral::BinLayout::parse(rd.string(root.at("bins"), "bins"), rd.input("bins"));
+  }
+  if (root.contains("samples")) s.sample_end = rd.integer(root.at("samples"), "samples", 1, std::int64_t{1} << 40);
+  if (root.contains("seed")) {
+    const json& j = root.at("seed");
+    if (!j.is_number_integer() || (!j.is_number_unsigned() && j.get<std::int64_t>() < 0)) {
+      rd.fail("seed", "must be an integer ≥ 0 (got " + Reader::describe(j) + ")");
+    }
+    s.seed = j.get<std::uint64_t>();
+  }
+  if (root.contains("max_bounces")) s.max_bounces = static_cast<int>(rd.integer(root.at("max_bounces"), "max_bounces", -1, 1000000));
+  if (root.contains("wavelength_sampling")) {
+    const std::string w = rd.string(root.at("wavelength_sampling"), "wavelength_sampling");
+    if (w == "spectral-tracking") s.wavelength_sampling = WavelengthSampling::SpectralTracking;
+    else if (w == "single") s.wavelength_sampling = WavelengthSampling::Single;
+    else rd.fail("wavelength_sampling", "must be \"spectral-tracking\" or \"single\" (got \"" + w + "\")");
+  }
+  if (root.contains("target_error")) {
+    s.target_error = rd.number(root.at("target_error"), "target_error");
+    if (s.target_error < 0.0) rd.fail("target_error", "must be ≥ 0 (got " + num(s.target_error) + ")");
+  }
+}
+
+// Parses JSON, rejecting duplicate keys, reporting line and column of syntax errors.
+json parse_json(const std::string& text, const std::string& file) {
+  std::vector<std::set<std::string>> keys;
+  std::string duplicate;
+  auto cb = [&](int /*depth*/, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) keys.emplace_back();
+    else if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+    else if (event == json::parse_event_t::key && !keys.empty() && parsed.is_string()) {
+      if (!keys.back().insert(parsed.get<std::string>()).second && duplicate.empty()) duplicate = parsed.get<std::string>();
+    }
+    return true;
+  };
+  try {
+    json j = json::parse(text, cb);
+    if (!duplicate.empty()) throw InputError(file, "duplicate key \"" + duplicate + "\"");
+    return j;
+  } catch (const json::parse_error& e) {
+    // Line and column of the offending byte.
+    std::size_t line = 1;
+    std::size_t col = 1;
+    const std::size_t end = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
+    for (std::size_t i = 0; i < end; ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    std::string what = e.what();
+    const std::size_t colon = what.find(": ", what.find("parse error"));
+    if (colon != std::string::npos) what = what.substr(colon + 2);
+    throw InputError(file, "malformed JSON at line " + std::to_string(line) + ", column " + std::to_string(col) + ": " + what);
+  }
+}
+
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file, "no such scene file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(file, "cannot open scene file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+
+  const json root = parse_json(text, file);
+  const Reader rd(file, path.parent_path());
+  rd.expect_object(root, "",
+                   {"description", "volume", "normalisation", "materials", "transfer_function", "camera", "lights",
+                    "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "target_error", "output"});
+  if (root.contains("description")) rd.string(root.at("description"), "description");
+  if (!root.contains("volume")) rd.fail("volume", "is required");
+  if (!root.contains("lights")) rd.fail("lights", "is required (at least one light)");
+  const bool has_materials = root.contains("materials");
+  const bool has_tf = root.contains("transfer_function");
+  if (has_materials == has_tf) {
+    rd.fail(has_materials ? "transfer_function" : "materials",
+            has_materials ? "give either materials or transfer_function, not both"
+                          : "is required (or a transfer_function image)");
+  }
+
+  Scene scene;
+  scene.source = path;
+  // Validate the cheap parts first so a typo is reported before a large volume is read.
+  scene.lights = read_lights(rd, root.at("lights"));
+  if (root.contains("camera")) scene.camera = read_camera(rd, root.at("camera"));
+  read_settings(rd, root, scene.settings);
+  scene.output = path.parent_path() / (path.stem().string() + ".exr");
+  if (root.contains("output")) scene.output = rd.file_path(root.at("output"), "output");
+
+  Volume vol = read_volume(rd, root.at("volume"));
+  const ValueNormalisation norm = read_normalisation(rd, root, vol);
+  const TransferFunction tf = has_materials ? read_materials(rd, root.at("materials"), norm)
+                                            : read_tf_image(rd, root.at("transfer_function"), norm);
+  scene.medium = build_medium(vol, tf, rd.input("volume"));
+
+  // Hash: scene text, volume values, the materials' spectra (which csv files or images may supply).
+  Fnv1a h;
+  h.add(text.data(), text.size());
+  h.add(vol.dims.data(), sizeof vol.dims);
+  h.add(vol.spacing.data(), sizeof vol.spacing);
+  h.add(vol.values.data(), vol.values.size() * sizeof(float));
+  for (const Material& m : scene.medium.materials) {
+    h.add(m.name.data(), m.name.size());
+    h.add_spectrum(m.albedo);
+    h.add_spectrum(m.sigma_t_per_unit);
+    h.add_spectrum(m.anisotropy);
+  }
+  scene.hash = h.hex();
+  return scene;
+}
+
+}  // namespace prizma::render

@@ -1,0 +1,120 @@
+// NIfTI-1 volumes (.nii, .nii.gz) through libnifti. The header is read and checked first (type,
+// dimensions, memory), then the voxels; every libnifti return is checked.
+#include <nifti1_io.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+
+#include "prizma/render/volume.h"
+#include "prizma/spectral/error.h"
+#include "volume_budget.h"
+
+namespace prizma::render {
+
+using spectral::InputError;
+
+namespace {
+
+struct NiftiFree {
+  void operator()(nifti_image* nim) const { nifti_image_free(nim); }
+};
+using NiftiPtr = std::unique_ptr<nifti_image, NiftiFree>;
+
+template <typename T>
+void convert(const void* data, std::size_t n, double slope, double inter, std::vector<float>& out) {
+  const T* p = static_cast<const T*>(data);
+  if (slope != 0.0) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(slope * static_cast<double>(p[i]) + inter);
+  } else {
+    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(p[i]);
+  }
+}
+
+std::string datatype_name(int dt) {
+  const char* s = nifti_datatype_to_string(dt);
+  return s != nullptr ? std::string(s) : "datatype " + std::to_string(dt);
+}
+
+}  // namespace
+
+Volume load_nifti_volume(const std::filesystem::path& path) {
+  const std::string input = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(input, "no such file");
+
+  // libnifti reports failures on stderr at debug level ≥ 1; we report them ourselves.
+  nifti_set_debug_level(0);
+  NiftiPtr nim(nifti_image_read(input.c_str(), 0));
+  if (!nim) throw InputError(input, "not a readable NIfTI-1 file (corrupt, truncated or another format)");
+
+  // Supported voxel types only.
+  const int dt = nim->datatype;
+  std::size_t file_bytes = 0;
+  switch (dt) {
+    case DT_UINT8: case DT_INT8: file_bytes = 1; break;
+    case DT_UINT16: case DT_INT16: file_bytes = 2; break;
+    case DT_UINT32: case DT_INT32: case DT_FLOAT32: file_bytes = 4; break;
+    case DT_FLOAT64: file_bytes = 8; break;
+    default:
+      throw InputError(input, "unsupported NIfTI datatype " + datatype_name(dt) +
+                                  " (supported: UINT8, INT8, UINT16, INT16, UINT32, INT32, FLOAT32, FLOAT64; "
+                                  "complex and RGB volumes are not scalar)");
+  }
+  if (nim->ndim < 1 || nim->ndim > 7) throw InputError(input, "invalid number of dimensions " + std::to_string(nim->ndim));
+  const long long extra = static_cast<long long>(std::max(nim->nt, 1)) * std::max(nim->nu, 1) *
+                          std::max(nim->nv, 1) * std::max(nim->nw, 1);
+  if (nim->ndim > 3 && extra > 1) {
+    throw InputError(input, "4-D or higher NIfTI with " + std::to_string(extra) +
+                                " volumes is not supported (only one 3-D volume)");
+  }
+  const std::array<int, 3> dims{nim->nx, nim->ny, std::max(nim->nz, 1)};
+  const std::size_t count = detail::check_volume_fits(dims, file_bytes, input);
+
+  // Spacing from pixdim (absolute; a collapsed axis of one voxel may carry 0).
+  std::array<double, 3> spacing{nim->dx, nim->dy, nim->dz};
+  for (int a = 0; a < 3; ++a) {
+    spacing[a] = std::abs(spacing[a]);
+    if (!std::isfinite(spacing[a]) || spacing[a] <= 0.0) {
+      if (dims[a] == 1) {
+        spacing[a] = 1.0;
+      } else {
+        throw InputError(input, "pixdim[" + std::to_string(a + 1) + "] must be positive (got " +
+                                    std::to_string(spacing[a]) + ")");
+      }
+    }
+  }
+  double slope = nim->scl_slope;
+  double inter = nim->scl_inter;
+  if (!std::isfinite(slope)) slope = 0.0;
+  if (!std::isfinite(inter)) inter = 0.0;
+
+  // Voxels.
+  if (nifti_image_load(nim.get()) != 0 || nim->data == nullptr) {
+    throw InputError(input, "cannot read the voxel data (file corrupt or truncated)");
+  }
+  if (static_cast<std::size_t>(nim->nvox) != count || static_cast<std::size_t>(nim->nbyper) != file_bytes) {
+    throw InputError(input, "inconsistent header: " + std::to_string(nim->nvox) + " voxels of " +
+                                std::to_string(nim->nbyper) + " bytes");
+  }
+  Volume vol;
+  vol.dims = dims;
+  vol.spacing = spacing;
+  vol.source = input;
+  vol.values.resize(count);
+  switch (dt) {
+    case DT_UINT8: convert<std::uint8_t>(nim->data, count, slope, inter, vol.values); break;
+    case DT_INT8: convert<std::int8_t>(nim->data, count, slope, inter, vol.values); break;
+    case DT_UINT16: convert<std::uint16_t>(nim->data, count, slope, inter, vol.values); break;
+    case DT_INT16: convert<std::int16_t>(nim->data, count, slope, inter, vol.values); break;
+    case DT_UINT32: convert<std::uint32_t>(nim->data, count, slope, inter, vol.values); break;
+    case DT_INT32: convert<std::int32_t>(nim->data, count, slope, inter, vol.values); break;
+    case DT_FLOAT32: convert<float>(nim->data, count, slope, inter, vol.values); break;
+    case DT_FLOAT64: convert<double>(nim->data, count, slope, inter, vol.values); break;
+    default: break;
+  }
+  return vol;
+}
+
+}  // namespace prizma::render
