@@ -1,0 +1,163 @@
+// prizma-relight: relights a spectral EXR under any light spectra, in milliseconds, with no re-render.
+// Thin over prizma::relight: parse options, validate, run a single image, a batch or a session.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "prizma/relight/batch_file.h"
+#include "prizma/relight/interactive_shell.h"
+#include "prizma/relight/output_image.h"
+#include "prizma/relight/relight_session.h"
+#include "prizma/relight/terminal_preview.h"
+#include "prizma/spectral/cli_support.h"
+#include "prizma/spectral/colour_matching.h"
+#include "prizma/spectral/data_path.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/tool_main.h"
+
+namespace {
+
+namespace relight = prizma::relight;
+namespace spectral = prizma::spectral;
+using spectral::InputError;
+
+struct CliOptions {
+  std::string input;
+  std::string output;
+  std::vector<std::string> lights;
+  double exposure_ev = 0.0;
+  std::string cmf = "1931";
+  bool adapt = false;
+  bool absolute = false;
+  std::string display = "sRGB";
+  std::string colour_space;
+  int bit_depth = 8;
+  std::string batch;
+  bool interactive = false;
+  std::string preview;
+  bool show = false;
+  bool verbose = false;
+};
+
+const char* cmf_table(spectral::Observer obs) {
+  switch (obs) {
+    case spectral::Observer::Cie1931_2deg: return "spectra/cie1931_xyz2deg_1nm.csv";
+    case spectral::Observer::Cie1964_10deg: return "spectra/cie1964_xyz10deg_1nm.csv";
+    case spectral::Observer::Cie2012_2deg: return "spectra/cie2012_xyz2deg_1nm.csv";
+    case spectral::Observer::Cie2012_10deg: return "spectra/cie2012_xyz10deg_1nm.csv";
+  }
+  return "";
+}
+
+// The command line's settings on top of the file's default lights.
+relight::RelightSettings settings_from(const CliOptions& o, const relight::RelightSession& session) {
+  relight::RelightSettings s = session.settings();
+  for (const std::string& arg : o.lights) {
+    const auto eq = arg.find('=');
+    if (eq == std::string::npos) {
+      const relight::LightSpec light = relight::parse_light_spec(arg, {"--light", {}});
+      std::fill(s.lights.begin(), s.lights.end(), light);
+    } else {
+      const std::string name = arg.substr(0, eq);
+      const int l = session.light_index(name, "--light");
+      s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec(arg.substr(eq + 1), {"--light " + name, {}});
+    }
+  }
+  if (!std::isfinite(o.exposure_ev) || std::abs(o.exposure_ev) > 64.0) {
+    throw InputError("--exposure", "must be a finite number of stops within ±64");
+  }
+  s.relight.exposure_ev = o.exposure_ev;
+  s.relight.cmf = spectral::parse_observer(o.cmf, "--cmf");
+  s.relight.adapt_to_d65 = o.adapt;
+  s.relight.units = o.absolute ? spectral::LightUnits::Absolute : spectral::LightUnits::RelativeToWhite;
+  s.output.display.display = o.display;
+  s.output.display.colour_space = o.colour_space;
+  s.output.bit_depth = o.bit_depth;
+  return s;
+}
+
+int run(const CliOptions& o) {
+  if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show) {
+    throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i or --show");
+  }
+  if (!o.preview.empty() && !o.interactive) throw InputError("--preview", "only with -i/--interactive");
+  // Cheap checks first: nothing is loaded when the output cannot be written.
+  if (!o.output.empty()) relight::check_output_path(o.output, "--output");
+  if (!o.preview.empty()) relight::check_output_path(o.preview, "--preview");
+
+  relight::RelightSession session(o.input);
+  session.apply(settings_from(o, session));
+  if (!o.output.empty()) {
+    relight::check_output_options(relight::output_format_for(o.output), session.settings().output);
+  }
+  if (o.verbose) {
+    const auto& s = session.settings();
+    std::cerr << "prizma-relight: input " << o.input << " (" << session.image().width << "×"
+              << session.image().height << ", " << session.image().bins.size() << " bins "
+              << session.image().bins.min_nm() << "–" << session.image().bins.max_nm() << " nm)\n"
+              << "prizma-relight: data " << spectral::data_dir().string() << "\n"
+              << "prizma-relight: cmf " << spectral::observer_name(s.relight.cmf) << " ("
+              << (spectral::data_dir() / cmf_table(s.relight.cmf)).string() << ")\n"
+              << "prizma-relight: OCIO config " << session.display().config_path().string() << ", "
+              << session.display().description() << "\n";
+    std::istringstream lights(session.describe_lights());
+    for (std::string line; std::getline(lights, line);) std::cerr << "prizma-relight: light " << line << "\n";
+  }
+
+  if (!o.batch.empty()) {
+    const auto outputs = relight::read_batch_file(o.batch, session, session.settings());
+    relight::run_batch(session, outputs, o.verbose ? &std::cerr : nullptr);
+    session.apply(settings_from(o, session));
+  }
+  if (!o.output.empty()) {
+    const double ms = session.relight();
+    session.save(o.output);
+    if (o.verbose) std::cerr << "prizma-relight: wrote " << o.output << " (relit in " << ms << " ms)\n";
+  }
+  if (o.show && !o.interactive) {
+    const relight::XyzImage& img = session.xyz();
+    relight::print_terminal_thumbnail(std::cout, relight::to_display(img, session.display()), img.width, img.height);
+  }
+  if (o.interactive) {
+    relight::InteractiveOptions io;
+    io.preview = o.preview;
+    io.show = o.show;
+    io.prompt = ::isatty(STDIN_FILENO) != 0;
+    relight::run_interactive(session, std::cin, std::cout, io);
+  }
+  return spectral::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Relights a Prizma spectral EXR under any light spectra (no re-render).", "prizma-relight"};
+  CliOptions o;
+  app.add_option("input", o.input, "spectral EXR written by prizma-render (or any reflective spectral EXR)")
+      ->required();
+  app.add_option("-o,--output", o.output, "output image: .png (8/16-bit), .tif, .exr (linear XYZ or --colour-space)");
+  app.add_option("--light", o.lights,
+                 "NAME=SPEC for one light layer, or SPEC for every layer; SPEC: D65, A, F11, LED-B1, "
+                 "blackbody:3200K, gaussian:550:20, box:500:560, csv:FILE, off, …*SCALE (repeatable)");
+  app.add_option("--exposure", o.exposure_ev, "exposure in stops (EV)");
+  app.add_option("--cmf", o.cmf, "colour matching functions: 1931, 1964, 2012-2, 2012-10")->capture_default_str();
+  app.add_flag("--adapt", o.adapt, "Bradford chromatic adaptation from the light mix's white to D65");
+  app.add_option("--display", o.display, "OCIO display for PNG/TIFF")->capture_default_str();
+  app.add_option("--colour-space,--color-space", o.colour_space, "linear OCIO colour space for EXR output");
+  app.add_flag("--absolute", o.absolute, "absolute light units (no normalisation to Y = 1 for white)");
+  app.add_option("--bit-depth", o.bit_depth, "PNG/TIFF bit depth")->check(CLI::IsMember({8, 16}))->capture_default_str();
+  app.add_option("--batch", o.batch, "JSON file listing outputs and their settings (docs/relight.md)");
+  app.add_flag("-i,--interactive", o.interactive, "read commands from stdin (type 'help')");
+  app.add_option("--preview", o.preview, "interactive: image rewritten after every change");
+  app.add_flag("--show", o.show, "print a true-colour terminal thumbnail");
+  app.add_flag("--verbose", o.verbose, "echo data files, OCIO config and lights");
+  app.set_version_flag("--version", prizma::spectral::prizma_version());
+  if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  return spectral::run_tool("prizma-relight", [&] { return run(o); });
+}

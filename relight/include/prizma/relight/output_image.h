@@ -1,0 +1,53 @@
+#pragma once
+// Writing a relit image: display transform (OpenColorIO) then OpenImageIO by extension, atomically.
+//   .png          display-encoded, 8-bit (default) or 16-bit
+//   .tif / .tiff  display-encoded, 8-bit or 16-bit
+//   .exr          linear float, no display transform: XYZ (channels X, Y, Z), or a linear colour
+//                 space of the OCIO config (channels R, G, B) when colour_space is set
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "prizma/relight/xyz_image.h"
+#include "prizma/spectral/display.h"
+
+namespace prizma::relight {
+
+enum class OutputFormat { Png, Tiff, Exr };
+
+// Format from the extension (case-insensitive). Throws InputError (input `input`) for others.
+OutputFormat output_format_for(const std::filesystem::path& path, const std::string& input = "--output");
+
+// Image attributes written into the output ("prizma:lights", "prizma:exposureEV", …).
+using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
+
+struct OutputOptions {
+  spectral::DisplayOptions display;  // display, or colour_space for linear EXR output
+  int bit_depth = 8;                 // 8 or 16, PNG and TIFF only
+};
+
+// Checks, before any work, that `path` can be written: a known extension, an existing folder that
+// is writable, and not a folder itself. Throws InputError (input `input`) naming the problem.
+void check_output_path(const std::filesystem::path& path, const std::string& input = "--output");
+
+// Display-encoded RGB of an XYZ image: a copy through the transform, clamped to [0, 1] for
+// integer outputs by the caller. Non-finite values become 0.
+std::vector<float> to_display(const XyzImage& image, const spectral::DisplayTransform& display);
+
+// The display options a format uses: PNG/TIFF the display (colour_space cleared); EXR the linear
+// colour space, or none (XYZ written as is) when colour_space is empty.
+bool needs_transform(OutputFormat format, const OutputOptions& opts);
+spectral::DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts);
+
+// Checks the options a format needs (builds the transform once); throws InputError when the config,
+// display or colour space does not exist, or the bit depth is not 8 or 16.
+void check_output_options(OutputFormat format, const OutputOptions& opts);
+
+// Writes the image (display transform for PNG/TIFF; for EXR only when colour_space is set).
+// Written atomically; throws InputError for bad paths or options, RuntimeError (naming the path and
+// OpenImageIO's message) for write failures.
+void write_output_image(const std::filesystem::path& path, const XyzImage& image,
+                        const OutputOptions& opts, const ImageMetadata& metadata);
+
+}  // namespace prizma::relight

@@ -1,0 +1,57 @@
+#pragma once
+// RelightMatrix: per light layer the 3×n matrix taking the layer's transport bins to CIE XYZ, with
+// exposure and optional chromatic adaptation folded in, and all layers stacked side by side.
+#include <Eigen/Core>
+#include <vector>
+
+#include "prizma/relight/light_spec.h"
+#include "prizma/spectral/bin_layout.h"
+#include "prizma/spectral/colour_matching.h"
+
+namespace prizma::relight {
+
+struct RelightOptions {
+  spectral::Observer cmf = spectral::Observer::Cie1931_2deg;
+  // RelativeToWhite: a perfect white (T = 1) under each light at scale 1 has Y = 1.
+  spectral::LightUnits units = spectral::LightUnits::RelativeToWhite;
+  double exposure_ev = 0.0;  // output multiplied by 2^exposure_ev
+  // Bradford adaptation from the white of the light mix (XYZ of T = 1 under all lights) to D65,
+  // preserving the white's luminance. Ignored when every light is off.
+  bool adapt_to_d65 = false;
+};
+
+using Matrix3Xd = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+using Matrix3Xf = Eigen::Matrix<float, 3, Eigen::Dynamic>;
+
+class RelightMatrix {
+ public:
+  RelightMatrix() = default;
+  // One LightSpec per transport layer, in the image's layer order. The weights are exact integrals
+  // of light × CMF over each bin (spectral::relight_weights); "off" layers get a zero matrix.
+  // Throws InputError (from relight_weights) when a light has no energy in the bins.
+  RelightMatrix(const spectral::BinLayout& bins, const std::vector<LightSpec>& lights,
+                const RelightOptions& opts);
+
+  int light_count() const { return static_cast<int>(m_per_light.size()); }
+  int bin_count() const { return m_bins; }
+  // Final 3×n matrix of light l (exposure and adaptation included).
+  const Matrix3Xd& light(int l) const { return m_per_light[static_cast<std::size_t>(l)]; }
+  // All lights side by side, 3×(L·n), float: columns [l·n, (l+1)·n) belong to light l.
+  const Matrix3Xf& stacked() const { return m_stacked; }
+  // XYZ of a perfect white (T = 1 in every bin of every layer) under the mix, before exposure and
+  // adaptation.
+  const Eigen::Vector3d& mix_white_xyz() const { return m_mix_white; }
+  // The adaptation applied (identity unless adapt_to_d65 and some light is on).
+  const Eigen::Matrix3d& adaptation() const { return m_adaptation; }
+  const RelightOptions& options() const { return m_options; }
+
+ private:
+  int m_bins = 0;
+  std::vector<Matrix3Xd> m_per_light;
+  Matrix3Xf m_stacked;
+  Eigen::Vector3d m_mix_white = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d m_adaptation = Eigen::Matrix3d::Identity();
+  RelightOptions m_options;
+};
+
+}  // namespace prizma::relight

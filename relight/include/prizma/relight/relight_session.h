@@ -1,0 +1,103 @@
+#pragma once
+// RelightSession: one spectral image loaded once, relit again and again as the lights, exposure,
+// CMF or display change (the interactive mode and batch files run on it; tests drive it directly).
+#include <Eigen/Core>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "prizma/relight/light_spec.h"
+#include "prizma/relight/output_image.h"
+#include "prizma/relight/relight_matrix.h"
+#include "prizma/relight/xyz_image.h"
+#include "prizma/spectral/display.h"
+#include "prizma/spectral/spectral_exr.h"
+
+namespace prizma::relight {
+
+// Everything that decides an output image besides the transport.
+struct RelightSettings {
+  std::vector<LightSpec> lights;  // one per layer, in the image's layer order
+  RelightOptions relight;
+  OutputOptions output;
+};
+
+// What `probe X Y` reports about one pixel.
+struct ProbeResult {
+  int x = 0, y = 0;
+  std::vector<std::vector<float>> bins;  // per layer, the transport bins at the pixel
+  Eigen::Vector3d xyz;                   // relit, exposure included
+  Eigen::Vector3d lab;                   // CIELAB, D65 white (Y = 1)
+  Eigen::Vector3d srgb;                  // sRGB (IEC 61966-2-1) encoded, unclamped
+};
+
+// What `compare` reports: the mean colours of two (2r+1)² regions (clipped to the image) and their
+// CIEDE2000 difference.
+struct CompareResult {
+  Eigen::Vector3d xyz1, xyz2, lab1, lab2;
+  double delta_e2000 = 0.0;
+};
+
+class RelightSession {
+ public:
+  // Reads the spectral EXR (InputError naming the path when it is not one). Lights start at their
+  // defaults: the file's prizma:lights spectrum for each layer, else D65.
+  explicit RelightSession(const std::filesystem::path& spectral_exr);
+  // Takes an image already in memory; `source` names it in messages and metadata.
+  RelightSession(spectral::SpectralImage image, std::string source);
+  ~RelightSession();
+
+  const spectral::SpectralImage& image() const { return m_image; }
+  const std::string& source() const { return m_source; }
+  // Layer names as users type them ("T" for an unnamed single layer).
+  const std::vector<std::string>& light_names() const { return m_light_names; }
+  // The layer's index; throws InputError (input `input`) listing the file's lights when unknown.
+  int light_index(std::string_view name, const std::string& input = "--light") const;
+  // Per layer, the default light (file's prizma:lights spectrum, else D65).
+  const std::vector<LightSpec>& default_lights() const { return m_default_lights; }
+
+  const RelightSettings& settings() const { return m_settings; }
+  // Replaces every setting at once; validates (builds the matrix and display) before committing,
+  // so a failure leaves the session as it was.
+  void apply(RelightSettings settings);
+  // Convenience setters (same all-or-nothing rule). An empty name sets every layer.
+  void set_light(std::string_view name, std::string_view spec);
+  void set_exposure(double exposure_ev);
+  void set_cmf(spectral::Observer cmf);
+  void set_display(const std::string& display);
+
+  // Relights with the current settings when anything changed; returns the time it took in ms
+  // (0 when nothing changed).
+  double relight();
+  const XyzImage& xyz();
+  const RelightMatrix& matrix() const { return m_matrix; }
+  // The display transform for the current settings (built when the display options change).
+  const spectral::DisplayTransform& display() const;
+
+  ProbeResult probe(int x, int y);
+  CompareResult compare(int x1, int y1, int x2, int y2, int radius = 0);
+  // Writes the current image (format by extension), with metadata().
+  void save(const std::filesystem::path& path);
+  // Attributes describing how the image was made.
+  ImageMetadata metadata() const;
+  // One line per layer: "name: spec".
+  std::string describe_lights() const;
+
+ private:
+  void check_pixel(int x, int y, const std::string& input) const;
+
+  spectral::SpectralImage m_image;
+  std::string m_source;
+  std::vector<std::string> m_light_names;
+  std::vector<LightSpec> m_default_lights;
+  RelightSettings m_settings;
+  RelightMatrix m_matrix;
+  std::unique_ptr<spectral::DisplayTransform> m_display;
+  spectral::DisplayOptions m_display_options;
+  XyzImage m_xyz;
+  bool m_dirty = true;
+};
+
+}  // namespace prizma::relight

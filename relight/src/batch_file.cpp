@@ -1,0 +1,142 @@
+#include "prizma/relight/batch_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/error.h"
+
+namespace prizma::relight {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using spectral::InputError;
+
+namespace {
+
+const std::set<std::string> kSettingKeys = {"lights", "exposure", "cmf",        "adapt",   "absolute",
+                                            "display", "view",    "colourSpace", "bitDepth"};
+
+// Applies the keys of one JSON object (an output or "defaults") onto settings. `where` names it.
+void apply_keys(const json& obj, const std::string& where, const RelightSession& session, const fs::path& base_dir,
+                RelightSettings& s) {
+  for (const auto& [key, value] : obj.items()) {
+    const std::string input = where + "." + key;
+    if (key == "file") continue;
+    if (!kSettingKeys.count(key)) {
+      throw InputError(input, "unknown key (known: file, lights, exposure, cmf, adapt, absolute, display, view, "
+                              "colourSpace, bitDepth)");
+    }
+    try {
+      if (key == "lights") {
+        if (value.is_string()) {
+          const LightSpec light = parse_light_spec(value.get<std::string>(), {input, base_dir});
+          std::fill(s.lights.begin(), s.lights.end(), light);
+        } else if (value.is_object()) {
+          for (const auto& [name, spec] : value.items()) {
+            if (!spec.is_string()) throw InputError(input + "." + name, "must be a spectrum spec string");
+            const int l = session.light_index(name, input);
+            s.lights[static_cast<std::size_t>(l)] = parse_light_spec(spec.get<std::string>(), {input + "." + name, base_dir});
+          }
+        } else {
+          throw InputError(input, "must be a spec string (every light) or an object {\"name\": \"spec\"}");
+        }
+      } else if (key == "exposure") {
+        s.relight.exposure_ev = value.get<double>();
+        if (!std::isfinite(s.relight.exposure_ev) || std::abs(s.relight.exposure_ev) > 64.0) {
+          throw InputError(input, "must be a finite number of stops within ±64");
+        }
+      } else if (key == "cmf") {
+        s.relight.cmf = spectral::parse_observer(value.get<std::string>(), input);
+      } else if (key == "adapt") {
+        s.relight.adapt_to_d65 = value.get<bool>();
+      } else if (key == "absolute") {
+        s.relight.units = value.get<bool>() ? spectral::LightUnits::Absolute : spectral::LightUnits::RelativeToWhite;
+      } else if (key == "display") {
+        s.output.display.display = value.get<std::string>();
+      } else if (key == "view") {
+        s.output.display.view = value.get<std::string>();
+      } else if (key == "colourSpace") {
+        s.output.display.colour_space = value.get<std::string>();
+      } else if (key == "bitDepth") {
+        s.output.bit_depth = value.get<int>();
+      }
+    } catch (const json::exception&) {
+      throw InputError(input, "wrong type: " + value.dump());
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSession& session,
+                                         const RelightSettings& base) {
+  const std::string name = path.string();
+  std::ifstream in(path);
+  if (!in) throw InputError(name, "cannot open batch file");
+  json doc;
+  try {
+    doc = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(name, std::string("not valid JSON: ") + e.what());
+  }
+  if (!doc.is_object() || !doc.contains("outputs") || !doc["outputs"].is_array() || doc["outputs"].empty()) {
+    throw InputError(name, "expected an object with a non-empty \"outputs\" array");
+  }
+  for (const auto& [key, value] : doc.items()) {
+    if (key != "outputs" && key != "defaults") throw InputError(name + ": " + key, "unknown key (known: defaults, outputs)");
+  }
+  const fs::path base_dir = path.parent_path();
+  RelightSettings defaults = base;
+  if (doc.contains("defaults")) {
+    if (!doc["defaults"].is_object()) throw InputError(name + ": defaults", "must be an object");
+    if (doc["defaults"].contains("file")) throw InputError(name + ": defaults.file", "not allowed in defaults");
+    apply_keys(doc["defaults"], name + ": defaults", session, base_dir, defaults);
+  }
+
+  std::vector<BatchOutput> outputs;
+  std::set<fs::path> seen;
+  const json& list = doc["outputs"];
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where = name + ": outputs[" + std::to_string(i) + "]";
+    const json& entry = list[i];
+    if (!entry.is_object()) throw InputError(where, "must be an object");
+    if (!entry.contains("file") || !entry["file"].is_string() || entry["file"].get<std::string>().empty()) {
+      throw InputError(where + ".file", "missing (the output image's path)");
+    }
+    BatchOutput out;
+    const fs::path file = entry["file"].get<std::string>();
+    out.file = file.is_absolute() ? file : base_dir / file;
+    if (!seen.insert(fs::weakly_canonical(out.file)).second) {
+      throw InputError(where + ".file", "\"" + file.string() + "\" is written by an earlier output too");
+    }
+    out.settings = defaults;
+    apply_keys(entry, where, session, base_dir, out.settings);
+    // Validate now so that a bad entry stops the batch before anything is written.
+    check_output_path(out.file, where + ".file");
+    RelightMatrix check(session.image().bins, out.settings.lights, out.settings.relight);
+    const OutputFormat format = output_format_for(out.file, where + ".file");
+    try {
+      check_output_options(format, out.settings.output);
+    } catch (const InputError& e) {
+      throw InputError(where, e.what());
+    }
+    outputs.push_back(std::move(out));
+  }
+  return outputs;
+}
+
+void run_batch(RelightSession& session, const std::vector<BatchOutput>& outputs, std::ostream* log) {
+  for (const BatchOutput& out : outputs) {
+    session.apply(out.settings);
+    const double ms = session.relight();
+    session.save(out.file);
+    if (log) *log << "wrote " << out.file.string() << " (relit in " << ms << " ms)\n";
+  }
+}
+
+}  // namespace prizma::relight

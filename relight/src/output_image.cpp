@@ -1,0 +1,112 @@
+#include "prizma/relight/output_image.h"
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <memory>
+
+#include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/error.h"
+
+namespace prizma::relight {
+
+namespace fs = std::filesystem;
+using spectral::InputError;
+
+OutputFormat output_format_for(const fs::path& path, const std::string& input) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".png") return OutputFormat::Png;
+  if (ext == ".tif" || ext == ".tiff") return OutputFormat::Tiff;
+  if (ext == ".exr") return OutputFormat::Exr;
+  throw InputError(input, "unknown output format \"" + path.string() + "\" (known: .png, .tif, .tiff, .exr)");
+}
+
+void check_output_path(const fs::path& path, const std::string& input) {
+  output_format_for(path, input);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw InputError(input, "\"" + path.string() + "\" is a folder");
+  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  if (!fs::is_directory(folder, ec)) {
+    throw InputError(input, "folder \"" + folder.string() + "\" of \"" + path.string() + "\" does not exist");
+  }
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+    throw InputError(input, "folder \"" + folder.string() + "\" of \"" + path.string() + "\" is not writable");
+  }
+}
+
+bool needs_transform(OutputFormat format, const OutputOptions& opts) {
+  return format != OutputFormat::Exr || !opts.display.colour_space.empty();
+}
+
+spectral::DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts) {
+  spectral::DisplayOptions d = opts.display;
+  if (format != OutputFormat::Exr) d.colour_space.clear();
+  return d;
+}
+
+void check_output_options(OutputFormat format, const OutputOptions& opts) {
+  if (opts.bit_depth != 8 && opts.bit_depth != 16) {
+    throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(opts.bit_depth));
+  }
+  if (needs_transform(format, opts)) spectral::DisplayTransform check(transform_options(format, opts));
+}
+
+std::vector<float> to_display(const XyzImage& image, const spectral::DisplayTransform& display) {
+  std::vector<float> rgb(image.xyz);
+  for (float& v : rgb)
+    if (!std::isfinite(v)) v = 0.0f;
+  display.apply(rgb.data(), image.pixel_count());
+  return rgb;
+}
+
+void write_output_image(const fs::path& path, const XyzImage& image, const OutputOptions& opts,
+                        const ImageMetadata& metadata) {
+  const OutputFormat format = output_format_for(path);
+  check_output_path(path);
+  check_output_options(format, opts);
+
+  // Pixels: linear XYZ / colour space for EXR, display-encoded and clamped to [0, 1] otherwise.
+  std::vector<float> pixels;
+  if (needs_transform(format, opts)) {
+    const spectral::DisplayTransform transform(transform_options(format, opts));
+    pixels = to_display(image, transform);
+  } else {
+    pixels = image.xyz;
+    for (float& v : pixels)
+      if (!std::isfinite(v)) v = 0.0f;
+  }
+  OIIO::TypeDesc type = OIIO::TypeDesc::FLOAT;
+  if (format != OutputFormat::Exr) {
+    for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
+    type = opts.bit_depth == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
+  }
+
+  OIIO::ImageSpec spec(image.width, image.height, 3, type);
+  if (format == OutputFormat::Exr && opts.display.colour_space.empty()) {
+    spec.channelnames = {"X", "Y", "Z"};
+  } else {
+    spec.channelnames = {"R", "G", "B"};
+  }
+  if (format == OutputFormat::Exr) spec.attribute("compression", "zip");
+  for (const auto& [key, value] : metadata) spec.attribute(key, value);
+
+  spectral::write_atomically(path, [&](const fs::path& tmp) {
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(tmp.string());
+    if (!out) throw spectral::RuntimeError(path.string() + ": cannot create writer: " + OIIO::geterror());
+    if (!out->open(tmp.string(), spec)) {
+      throw spectral::RuntimeError(path.string() + ": " + out->geterror());
+    }
+    if (!out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) {
+      const std::string err = out->geterror();
+      out->close();
+      throw spectral::RuntimeError(path.string() + ": " + err);
+    }
+    if (!out->close()) throw spectral::RuntimeError(path.string() + ": " + out->geterror());
+  });
+}
+
+}  // namespace prizma::relight

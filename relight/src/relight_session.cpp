@@ -1,0 +1,247 @@
+#include "prizma/relight/relight_session.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/colour.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/tool_main.h"
+
+namespace prizma::relight {
+
+namespace {
+
+using spectral::InputError;
+
+// Default light per layer: the spectrum recorded in prizma:lights for that name, else D65.
+std::vector<LightSpec> read_default_lights(const spectral::SpectralImage& image, const std::vector<std::string>& names,
+                                           const std::string& source) {
+  nlohmann::json lights = nlohmann::json::array();
+  if (!image.info.lights_json.empty()) {
+    try {
+      lights = nlohmann::json::parse(image.info.lights_json);
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(source, std::string("prizma:lights is not valid JSON: ") + e.what());
+    }
+  }
+  std::vector<LightSpec> out;
+  for (std::size_t l = 0; l < names.size(); ++l) {
+    std::string spec = "D65";
+    if (lights.is_array()) {
+      for (std::size_t j = 0; j < lights.size(); ++j) {
+        const auto& entry = lights[j];
+        if (!entry.is_object() || !entry.contains("spectrum") || !entry["spectrum"].is_string()) continue;
+        const std::string name = entry.value("name", std::string());
+        // A single-layer file: its one light is the layer whatever its name.
+        if (name == image.lights[l].name || (names.size() == 1 && lights.size() == 1)) {
+          spec = entry["spectrum"].get<std::string>();
+        }
+      }
+    }
+    out.push_back(parse_light_spec(spec, {source + ": prizma:lights " + names[l], {}}));
+  }
+  return out;
+}
+
+Eigen::Vector3d xyz_to_srgb_encoded(const Eigen::Vector3d& xyz) {
+  const Eigen::Vector3d lin = spectral::xyz_to_linear_srgb(xyz);
+  Eigen::Vector3d enc;
+  // srgb_encode maps negatives to 0; keep the sign so out-of-gamut colours stay visible in probes.
+  for (int c = 0; c < 3; ++c) enc[c] = std::copysign(spectral::srgb_encode(std::abs(lin[c])), lin[c]);
+  return enc;
+}
+
+}  // namespace
+
+RelightSession::RelightSession(const std::filesystem::path& spectral_exr)
+    : RelightSession(spectral::read_spectral_exr(spectral_exr), spectral_exr.string()) {}
+
+RelightSession::RelightSession(spectral::SpectralImage image, std::string source)
+    : m_image(std::move(image)), m_source(std::move(source)) {
+  if (m_image.lights.empty()) throw InputError(m_source, "no transport layers");
+  for (const auto& layer : m_image.lights) m_light_names.push_back(layer.name.empty() ? "T" : layer.name);
+  m_default_lights = read_default_lights(m_image, m_light_names, m_source);
+  RelightSettings settings;
+  settings.lights = m_default_lights;
+  apply(std::move(settings));
+}
+
+RelightSession::~RelightSession() = default;
+
+int RelightSession::light_index(std::string_view name, const std::string& input) const {
+  for (std::size_t l = 0; l < m_light_names.size(); ++l)
+    if (m_light_names[l] == name) return static_cast<int>(l);
+  std::string known;
+  for (const auto& n : m_light_names) known += (known.empty() ? "" : ", ") + n;
+  throw InputError(input, "no light \"" + std::string(name) + "\" in " + m_source + " (its lights: " + known + ")");
+}
+
+void RelightSession::apply(RelightSettings settings) {
+  if (settings.lights.size() != m_image.lights.size()) {
+    throw InputError("lights", "expected " + std::to_string(m_image.lights.size()) + " lights, got " +
+                                   std::to_string(settings.lights.size()));
+  }
+  // Build everything first; commit only when all of it succeeded.
+  RelightMatrix matrix(m_image.bins, settings.lights, settings.relight);
+  if (settings.output.bit_depth != 8 && settings.output.bit_depth != 16) {
+    throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(settings.output.bit_depth));
+  }
+  spectral::DisplayOptions display_options = settings.output.display;
+  display_options.colour_space.clear();
+  std::unique_ptr<spectral::DisplayTransform> display;
+  const bool display_changed = !m_display || display_options.config != m_display_options.config ||
+                               display_options.display != m_display_options.display ||
+                               display_options.view != m_display_options.view;
+  if (display_changed) display = std::make_unique<spectral::DisplayTransform>(display_options);
+  if (!settings.output.display.colour_space.empty()) check_output_options(OutputFormat::Exr, settings.output);
+
+  m_settings = std::move(settings);
+  m_matrix = std::move(matrix);
+  if (display_changed) {
+    m_display = std::move(display);
+    m_display_options = display_options;
+  }
+  m_dirty = true;
+}
+
+void RelightSession::set_light(std::string_view name, std::string_view spec) {
+  RelightSettings s = m_settings;
+  const std::string input = name.empty() ? "light" : "light " + std::string(name);
+  const LightSpec light = parse_light_spec(spec, {input, {}});
+  if (name.empty()) {
+    std::fill(s.lights.begin(), s.lights.end(), light);
+  } else {
+    s.lights[static_cast<std::size_t>(light_index(name, "light"))] = light;
+  }
+  apply(std::move(s));
+}
+
+void RelightSession::set_exposure(double exposure_ev) {
+  if (!std::isfinite(exposure_ev) || std::abs(exposure_ev) > 64.0) {
+    throw InputError("exposure", "must be a finite number of stops within ±64");
+  }
+  RelightSettings s = m_settings;
+  s.relight.exposure_ev = exposure_ev;
+  apply(std::move(s));
+}
+
+void RelightSession::set_cmf(spectral::Observer cmf) {
+  RelightSettings s = m_settings;
+  s.relight.cmf = cmf;
+  apply(std::move(s));
+}
+
+void RelightSession::set_display(const std::string& display) {
+  RelightSettings s = m_settings;
+  s.output.display.display = display;
+  s.output.display.view.clear();
+  apply(std::move(s));
+}
+
+double RelightSession::relight() {
+  if (!m_dirty) return 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  m_xyz.width = m_image.width;
+  m_xyz.height = m_image.height;
+  m_xyz.xyz.resize(3 * m_image.pixel_count());
+  relight_into(m_image, m_matrix, m_xyz.xyz.data());
+  m_dirty = false;
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+const XyzImage& RelightSession::xyz() {
+  relight();
+  return m_xyz;
+}
+
+const spectral::DisplayTransform& RelightSession::display() const { return *m_display; }
+
+void RelightSession::check_pixel(int x, int y, const std::string& input) const {
+  if (x < 0 || y < 0 || x >= m_image.width || y >= m_image.height) {
+    throw InputError(input, "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") outside the " +
+                                std::to_string(m_image.width) + "×" + std::to_string(m_image.height) + " image");
+  }
+}
+
+ProbeResult RelightSession::probe(int x, int y) {
+  check_pixel(x, y, "probe");
+  ProbeResult r;
+  r.x = x;
+  r.y = y;
+  const std::size_t n = static_cast<std::size_t>(m_image.bins.size());
+  const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(m_image.width) + static_cast<std::size_t>(x);
+  for (const auto& layer : m_image.lights) {
+    r.bins.emplace_back(layer.data.begin() + static_cast<std::ptrdiff_t>(p * n),
+                        layer.data.begin() + static_cast<std::ptrdiff_t>((p + 1) * n));
+  }
+  r.xyz = xyz().at(x, y);
+  r.lab = spectral::xyz_to_lab(r.xyz, spectral::white_d65());
+  r.srgb = xyz_to_srgb_encoded(r.xyz);
+  return r;
+}
+
+CompareResult RelightSession::compare(int x1, int y1, int x2, int y2, int radius) {
+  check_pixel(x1, y1, "compare");
+  check_pixel(x2, y2, "compare");
+  if (radius < 0) throw InputError("compare", "radius must be ≥ 0, not " + std::to_string(radius));
+  const XyzImage& img = xyz();
+  // Mean XYZ over the (2r+1)² square around (cx, cy), clipped to the image.
+  auto mean = [&](int cx, int cy) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (int y = std::max(0, cy - radius); y <= std::min(img.height - 1, cy + radius); ++y)
+      for (int x = std::max(0, cx - radius); x <= std::min(img.width - 1, cx + radius); ++x, ++count)
+        sum += img.at(x, y);
+    return Eigen::Vector3d(sum / count);
+  };
+  CompareResult r;
+  r.xyz1 = mean(x1, y1);
+  r.xyz2 = mean(x2, y2);
+  r.lab1 = spectral::xyz_to_lab(r.xyz1, spectral::white_d65());
+  r.lab2 = spectral::xyz_to_lab(r.xyz2, spectral::white_d65());
+  r.delta_e2000 = spectral::delta_e2000(r.lab1, r.lab2);
+  return r;
+}
+
+void RelightSession::save(const std::filesystem::path& path) {
+  write_output_image(path, xyz(), m_settings.output, metadata());
+}
+
+ImageMetadata RelightSession::metadata() const {
+  nlohmann::json lights = nlohmann::json::array();
+  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
+    lights.push_back({{"name", m_light_names[l]}, {"spectrum", m_settings.lights[l].text}});
+  }
+  std::ostringstream exposure;
+  exposure << m_settings.relight.exposure_ev;
+  ImageMetadata md = {
+      {"Software", "prizma-relight " + spectral::prizma_version()},
+      {"prizma:source", m_source},
+      {"prizma:lights", lights.dump()},
+      {"prizma:exposureEV", exposure.str()},
+      {"prizma:cmf", spectral::observer_name(m_settings.relight.cmf)},
+      {"prizma:units", m_settings.relight.units == spectral::LightUnits::Absolute ? "absolute" : "relative-to-white"},
+      {"prizma:adaptation", m_settings.relight.adapt_to_d65 ? "bradford-to-D65" : "none"},
+      {"prizma:binEdgesNm", m_image.bins.to_string()},
+  };
+  if (!m_settings.output.display.colour_space.empty()) {
+    md.emplace_back("prizma:colourSpace", m_settings.output.display.colour_space);
+  }
+  md.emplace_back("prizma:display", m_display ? m_display->description() : m_settings.output.display.display);
+  return md;
+}
+
+std::string RelightSession::describe_lights() const {
+  std::string out;
+  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
+    out += m_light_names[l] + ": " + m_settings.lights[l].text + " (default " + m_default_lights[l].text + ")\n";
+  }
+  return out;
+}
+
+}  // namespace prizma::relight
