@@ -1,0 +1,255 @@
+// prizma-metamer: designs metamers (a reflectance that matches another under one light and differs
+// under a second) and lights that hide or reveal the difference between two materials; prints the
+// CIEDE2000 table under the lights involved and a standard list.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "prizma/spectral/cli_support.h"
+#include "prizma/spectral/colour.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/light_design.h"
+#include "prizma/spectral/metamer_design.h"
+#include "prizma/spectral/spectrum_spec.h"
+#include "prizma/spectral/tool_main.h"
+
+namespace ps = prizma::spectral;
+
+namespace {
+
+struct CommonOptions {
+  std::string bins;
+  std::string cmf = "1931";
+  bool verbose = false;
+};
+
+struct MetamerCommand {
+  std::string albedo;
+  std::string match_light;
+  std::string split_light;
+  std::string output;
+  int basis = 20;
+  double min_value = 0.0;
+  double max_value = 1.0;
+};
+
+struct LightCommand {
+  std::string albedo_a;
+  std::string albedo_b;
+  std::string scene;
+  std::string material_a;
+  std::string material_b;
+  bool hide = false;
+  bool reveal = false;
+  std::string reference = "D65";
+  std::vector<std::string> primaries;
+  std::string output;
+  int basis = 40;
+};
+
+struct DeltaECommand {
+  std::string light = "D65";
+  std::vector<double> xyz_a;
+  std::vector<double> xyz_b;
+};
+
+ps::ColourSetting colour_setting(const CommonOptions& common) {
+  ps::ColourSetting colour;
+  colour.observer = ps::parse_observer(common.cmf, "--cmf");
+  if (!common.bins.empty()) colour.bins = ps::BinLayout::parse(common.bins, "--bins");
+  return colour;
+}
+
+ps::Spectrum parse_option(const std::string& spec, const std::string& option) {
+  return ps::parse_spectrum(spec, ps::SpecContext{option, {}});
+}
+
+// The albedo of a material of a scene file: `materials` as an array of objects with "name" (or
+// looked up by index) or as an object keyed by name; "albedo" a spec string or a number.
+ps::Spectrum scene_albedo(const std::filesystem::path& scene_path, const std::string& material) {
+  std::ifstream in(scene_path);
+  if (!in) throw ps::InputError(scene_path.string(), "cannot open the scene file");
+  nlohmann::json scene;
+  try {
+    scene = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw ps::InputError(scene_path.string(), std::string("not valid JSON: ") + e.what());
+  }
+  const auto materials = scene.find("materials");
+  if (materials == scene.end()) throw ps::InputError(scene_path.string(), "no \"materials\"");
+  const nlohmann::json* found = nullptr;
+  std::string where;
+  if (materials->is_object()) {
+    const auto it = materials->find(material);
+    if (it != materials->end()) {
+      found = &*it;
+      where = "materials." + material;
+    }
+  } else if (materials->is_array()) {
+    for (size_t i = 0; i < materials->size(); ++i) {
+      const nlohmann::json& m = (*materials)[i];
+      if ((m.is_object() && m.value("name", std::string()) == material) || std::to_string(i) == material) {
+        found = &m;
+        where = "materials[" + std::to_string(i) + "]";
+        break;
+      }
+    }
+  }
+  if (!found) throw ps::InputError(scene_path.string(), "no material \"" + material + "\"");
+  const auto albedo = found->find("albedo");
+  const std::string input = scene_path.string() + ": " + where + ".albedo";
+  if (albedo == found->end()) throw ps::InputError(input, "missing");
+  if (albedo->is_number()) return ps::Spectrum::constant(albedo->get<double>());
+  if (!albedo->is_string()) throw ps::InputError(input, "expected a spectrum spec string or a number");
+  return ps::parse_spectrum(albedo->get<std::string>(), ps::SpecContext{input, scene_path.parent_path()});
+}
+
+void print_table(const std::vector<ps::NamedLight>& lights, const std::vector<double>& values,
+                 const std::string& header) {
+  std::printf("%-24s %10s\n", "light", header.c_str());
+  for (size_t i = 0; i < lights.size(); ++i) std::printf("%-24s %10.3f\n", lights[i].name.c_str(), values[i]);
+}
+
+int run_metamer(const MetamerCommand& cmd, const CommonOptions& common) {
+  ps::MetamerOptions options;
+  options.colour = colour_setting(common);
+  options.basis_size = cmd.basis;
+  options.min_value = cmd.min_value;
+  options.max_value = cmd.max_value;
+  const ps::Spectrum albedo = parse_option(cmd.albedo, "--albedo");
+  const ps::Spectrum match = parse_option(cmd.match_light, "--match-light");
+  const ps::Spectrum split = parse_option(cmd.split_light, "--split-light");
+  const ps::MetamerResult result = ps::design_metamer(albedo, match, split, options);
+  ps::write_spectrum_csv(cmd.output, result.reflectance, "reflectance");
+
+  std::vector<ps::NamedLight> lights{{"match " + cmd.match_light, match}, {"split " + cmd.split_light, split}};
+  for (ps::NamedLight& l : ps::standard_report_lights()) lights.push_back(std::move(l));
+  std::vector<double> values;
+  for (const ps::NamedLight& l : lights)
+    values.push_back(ps::delta_e2000_under(albedo, result.reflectance, l.spectrum, options.colour));
+  std::printf("metamer of %s written to %s (values %.3f..%.3f)\n", cmd.albedo.c_str(), cmd.output.c_str(),
+              result.reflectance.min_value(), result.reflectance.max_value());
+  print_table(lights, values, "dE00");
+  return ps::kExitOk;
+}
+
+int run_light(const LightCommand& cmd, const CommonOptions& common) {
+  if (cmd.hide == cmd.reveal) throw ps::InputError("--hide/--reveal", "give exactly one of them");
+  ps::LightDesignOptions options;
+  options.colour = colour_setting(common);
+  options.basis_size = cmd.basis;
+  const auto albedo = [&](const std::string& spec, const std::string& material, const std::string& letter) {
+    const std::string spec_option = "--albedo-" + letter;
+    const std::string material_option = "--material-" + letter;
+    if (!spec.empty() && !material.empty())
+      throw ps::InputError(spec_option, "give either " + spec_option + " or " + material_option + ", not both");
+    if (!material.empty()) {
+      if (cmd.scene.empty()) throw ps::InputError(material_option, "needs --scene");
+      return scene_albedo(cmd.scene, material);
+    }
+    if (spec.empty()) throw ps::InputError(spec_option, "missing (or give --scene and " + material_option + ")");
+    return parse_option(spec, spec_option);
+  };
+  const ps::Spectrum a = albedo(cmd.albedo_a, cmd.material_a, "a");
+  const ps::Spectrum b = albedo(cmd.albedo_b, cmd.material_b, "b");
+  const ps::Spectrum reference = parse_option(cmd.reference, "--reference");
+  std::vector<ps::Spectrum> primaries;
+  for (size_t i = 0; i < cmd.primaries.size(); ++i)
+    primaries.push_back(parse_option(cmd.primaries[i], "--primaries[" + std::to_string(i) + "]"));
+  const ps::LightDesignResult result =
+      ps::design_light(a, b, cmd.hide ? ps::LightGoal::Hide : ps::LightGoal::Reveal, reference, primaries, options);
+  ps::write_spectrum_csv(cmd.output, result.light, "relative_spd");
+
+  std::printf("%s light written to %s\n", cmd.hide ? "hiding" : "revealing", cmd.output.c_str());
+  if (!primaries.empty()) {
+    std::printf("mix:");
+    for (size_t i = 0; i < primaries.size(); ++i) std::printf(" %s*%.6g", cmd.primaries[i].c_str(), result.weights[i]);
+    std::printf("\n");
+  }
+  std::vector<ps::NamedLight> lights{{"designed", result.light}, {"reference " + cmd.reference, reference}};
+  for (ps::NamedLight& l : ps::standard_report_lights()) lights.push_back(std::move(l));
+  std::vector<double> values;
+  for (const ps::NamedLight& l : lights) values.push_back(ps::delta_e2000_under(a, b, l.spectrum, options.colour));
+  print_table(lights, values, "dE00");
+  return ps::kExitOk;
+}
+
+int run_delta_e(const DeltaECommand& cmd, const CommonOptions& common) {
+  const ps::ColourSetting colour = colour_setting(common);
+  const ps::Spectrum light = parse_option(cmd.light, "--light");
+  // The white of a relit image: a perfect white (transport 1 in every bin) under the light.
+  const Eigen::Vector3d white = ps::reflectance_xyz(ps::Spectrum::constant(1.0), light, colour);
+  const Eigen::Vector3d xyz_a(cmd.xyz_a[0], cmd.xyz_a[1], cmd.xyz_a[2]);
+  const Eigen::Vector3d xyz_b(cmd.xyz_b[0], cmd.xyz_b[1], cmd.xyz_b[2]);
+  if (!xyz_a.allFinite() || !xyz_b.allFinite()) throw ps::InputError("--xyz-a/--xyz-b", "values must be finite");
+  const Eigen::Vector3d lab_a = ps::xyz_to_lab(xyz_a, white);
+  const Eigen::Vector3d lab_b = ps::xyz_to_lab(xyz_b, white);
+  std::printf("Lab a: %.3f %.3f %.3f\nLab b: %.3f %.3f %.3f\ndE00: %.4f\n", lab_a[0], lab_a[1], lab_a[2], lab_b[0],
+              lab_b[1], lab_b[2], ps::delta_e2000(lab_a, lab_b));
+  return ps::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string program = "prizma-metamer";
+  CLI::App app{"Designs metamers and lights that hide or reveal the difference between two materials.\n"
+               "Spectra are spec strings: D65, A, F11, LED-B3, cc:<patch>, gaussian:550:20, box:500:560,\n"
+               "blackbody:3200K, csv:file.csv, 0.5, SPEC*0.5.",
+               program};
+  app.set_version_flag("--version", ps::prizma_version());
+  app.require_subcommand(1);
+  CommonOptions common;
+  app.add_option("--bins", common.bins,
+                 "bins the colours are computed in, e.g. a render's 'linear:380:780:16' (default: 1 nm, 380-780 nm)");
+  app.add_option("--cmf", common.cmf, "observer: 1931, 1964, 2012-2, 2012-10")->capture_default_str();
+
+  MetamerCommand metamer;
+  CLI::App* sub_metamer = app.add_subcommand(
+      "metamer", "design a smooth reflectance in [0,1] matching --albedo under --match-light, different under --split-light");
+  sub_metamer->add_option("--albedo", metamer.albedo, "the reflectance to match")->required();
+  sub_metamer->add_option("--match-light", metamer.match_light, "light under which both look the same")->required();
+  sub_metamer->add_option("--split-light", metamer.split_light, "light under which they should differ most")->required();
+  sub_metamer->add_option("-o,--output", metamer.output, "output CSV (nm, reflectance)")->required();
+  sub_metamer->add_option("--basis", metamer.basis, "number of B-spline basis functions (smoothness)")
+      ->capture_default_str()->check(CLI::Range(6, 200));
+  sub_metamer->add_option("--min", metamer.min_value, "lower bound of the reflectance")->capture_default_str();
+  sub_metamer->add_option("--max", metamer.max_value, "upper bound of the reflectance")->capture_default_str();
+
+  LightCommand light;
+  CLI::App* sub_light = app.add_subcommand(
+      "light", "design a light (same luminance as --reference) that hides or reveals the difference of two albedos");
+  sub_light->add_option("--albedo-a", light.albedo_a, "first albedo spectrum");
+  sub_light->add_option("--albedo-b", light.albedo_b, "second albedo spectrum");
+  sub_light->add_option("--scene", light.scene, "scene JSON to read materials' albedos from");
+  sub_light->add_option("--material-a", light.material_a, "first material's name (or index) in --scene");
+  sub_light->add_option("--material-b", light.material_b, "second material's name (or index) in --scene");
+  sub_light->add_flag("--hide", light.hide, "make the two look the same (dE00 -> 0)");
+  sub_light->add_flag("--reveal", light.reveal, "make the two look as different as possible");
+  sub_light->add_option("--reference", light.reference, "reference light (luminance, comparison)")->capture_default_str();
+  sub_light->add_option("--primaries", light.primaries, "restrict to a non-negative mix of these spectra (comma separated)")
+      ->delimiter(',');
+  sub_light->add_option("--basis", light.basis, "free-form light: number of B-spline basis functions")
+      ->capture_default_str()->check(CLI::Range(6, 200));
+  sub_light->add_option("-o,--output", light.output, "output CSV (nm, relative spectral power)")->required();
+
+  DeltaECommand delta;
+  CLI::App* sub_delta = app.add_subcommand(
+      "delta-e", "CIEDE2000 between two XYZ colours of an image relit under --light (white: a perfect reflector)");
+  sub_delta->add_option("--light", delta.light, "the light the image was relit with")->capture_default_str();
+  sub_delta->add_option("--xyz-a", delta.xyz_a, "X,Y,Z of the first colour")->required()->expected(3)->delimiter(',');
+  sub_delta->add_option("--xyz-b", delta.xyz_b, "X,Y,Z of the second colour")->required()->expected(3)->delimiter(',');
+
+  if (const int code = ps::parse_command_line(app, argc, argv); code >= 0) return code;
+  return ps::run_tool(program, [&]() {
+    if (*sub_metamer) return run_metamer(metamer, common);
+    if (*sub_light) return run_light(light, common);
+    return run_delta_e(delta, common);
+  });
+}
