@@ -1,0 +1,67 @@
+#pragma once
+// MajorantGrid: macrocells of kCellVoxels³ voxels over the medium, each holding an upper bound of the
+// extinction σt(λ) inside it over every wavelength of the render (density × the material's largest
+// σt in the bins' range). Free-flight and transmittance sampling walk the cells with a 3-D DDA
+// (Amanatides & Woo 1987), so cells whose majorant is 0 cost one step. With one cell it is the single
+// global majorant (settings.use_majorant_grid = false).
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "prizma/render/camera.h"
+#include "prizma/render/scene.h"
+
+namespace prizma::render {
+
+class MajorantGrid {
+ public:
+  static constexpr int kCellVoxels = 8;
+
+  MajorantGrid() = default;
+  // sigma_t_max[m]: the largest σt per unit density of material m over the render's wavelengths.
+  // cell_voxels ≤ 0 builds one cell over the whole box.
+  MajorantGrid(const Medium& medium, const std::vector<float>& sigma_t_max, int cell_voxels = kCellVoxels);
+
+  const std::array<int, 3>& cells() const { return m_cells; }
+  float majorant(int cx, int cy, int cz) const {
+    return m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx];
+  }
+  float max_majorant() const { return m_max; }
+  const Eigen::Vector3d& bounds_min() const { return m_min; }
+  const Eigen::Vector3d& bounds_max() const { return m_max_corner; }
+  const Eigen::Vector3d& cell_size() const { return m_cell_size; }
+
+ private:
+  std::array<int, 3> m_cells{1, 1, 1};
+  Eigen::Vector3d m_min{0, 0, 0}, m_max_corner{0, 0, 0}, m_cell_size{1, 1, 1};
+  std::vector<float> m_majorant;
+  float m_max = 0.0f;
+};
+
+// Parametric interval [t_enter, t_exit] of a ray inside an axis-aligned box; false when it misses
+// (or only touches it, or the box lies behind the origin).
+bool intersect_box(const Ray& ray, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double& t_enter,
+                   double& t_exit);
+
+// Walks the cells a ray segment [t_min, t_max] crosses, in order: next() gives each cell's
+// [t0, t1] and majorant. The ray must start inside or enter the grid's box within the segment.
+class MajorantTraversal {
+ public:
+  MajorantTraversal(const MajorantGrid& grid, const Ray& ray, double t_min, double t_max);
+  struct Segment {
+    double t0, t1;
+    float majorant;
+    std::array<int, 3> cell;
+  };
+  // False when the segment is exhausted.
+  bool next(Segment& seg);
+
+ private:
+  const MajorantGrid* m_grid;
+  double m_t = 0, m_t_max = 0;
+  std::array<int, 3> m_cell{0, 0, 0}, m_step{0, 0, 0};
+  std::array<double, 3> m_next_t{0, 0, 0}, m_delta_t{0, 0, 0};
+  bool m_done = true;
+};
+
+}  // namespace prizma::render

@@ -1,0 +1,91 @@
+#pragma once
+// PathTracer: one path of the spectral volume path tracer (docs/renderer.md). A path carries n
+// "lanes", each a wavelength with its own weight: all bins (spectral tracking, Kutz et al. 2017,
+// max scheme), or one lane (a wavelength-independent medium traced once for all bins, or VPT's
+// one-wavelength method). It returns, per lane, the radiance reaching the camera from the uniform
+// unit environment and from each directional light of unit irradiance (unit white spectra).
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "prizma/render/camera.h"
+#include "prizma/render/majorant_grid.h"
+#include "prizma/render/rng.h"
+#include "prizma/render/scene.h"
+
+namespace prizma::render {
+
+// Counters a path adds to (summed per thread, then over threads).
+struct PathCounters {
+  std::int64_t paths_in_volume = 0;
+  std::int64_t collisions = 0;
+  std::int64_t shadow_steps = 0;
+  std::int64_t majorant_cells = 0;
+};
+
+// Per-thread working memory, sized once for n lanes and the scene's materials.
+struct PathScratch {
+  int lanes = 0;
+  std::vector<float> lambda_nm;     // [lanes]
+  std::vector<float> sigma_t;       // [material][lanes] per unit density, at the path's wavelengths
+  std::vector<float> albedo;        // [material][lanes]
+  std::vector<float> g;             // [material][lanes]
+  std::vector<std::uint32_t> material_stamp;  // path id that last evaluated each material
+  std::uint32_t path_id = 0;
+  std::vector<float> weight;        // [lanes] path throughput
+  std::vector<float> transmittance; // [lanes] ratio tracking
+  std::vector<float> phase;         // [lanes]
+  std::vector<float> sigma_a, sigma_s, sigma_n;  // [lanes] at the current collision
+  std::vector<float> environment;   // [lanes] result: radiance from the unit environment
+  std::vector<float> directional;   // [directional light][lanes] result
+  PathCounters counters;
+};
+
+class PathTracer {
+ public:
+  // Precomputes the material extinction bounds over [lambda_lo_nm, lambda_hi_nm], the majorant
+  // grid (one cell when use_grid is false) and the light samplers.
+  PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi_nm, bool use_grid);
+
+  // Sizes scratch for `lanes` lanes.
+  void prepare(PathScratch& scratch, int lanes) const;
+  // Traces the path of a camera ray at the wavelengths in scratch.lambda_nm (set by the caller).
+  // Results in scratch.environment and scratch.directional (overwritten).
+  void trace(const Ray& ray, Rng& rng, PathScratch& scratch) const;
+
+  // True when the ray meets the medium's box (a miss sees only the environment).
+  bool hits_medium(const Ray& ray) const;
+  // Directional (non-environment) lights, in scene order: their indices in scene.lights.
+  const std::vector<int>& directional_lights() const { return m_directional_index; }
+  const MajorantGrid& grid() const { return m_grid; }
+  // True when every material's spectra are constant: one lane serves all bins.
+  bool wavelength_independent() const { return m_wavelength_independent; }
+
+ private:
+  struct DirectionalLight {
+    Eigen::Vector3d direction;  // unit, toward the light
+    double cos_max = 1.0;       // cone half-angle cosine; 1 = delta
+  };
+  template <int kLanes>
+  void trace_lanes(const Ray& ray, Rng& rng, PathScratch& s) const;
+  template <int kLanes>
+  void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s) const;
+  void evaluate_material(int m, PathScratch& s) const;
+  // Voxel at a point inside the box: material index (kEmpty outside) and density.
+  void lookup(const Eigen::Vector3d& p, std::uint16_t& material, float& density) const;
+
+  const Medium* m_medium;
+  MajorantGrid m_grid;
+  Eigen::Vector3d m_inv_voxel;
+  std::vector<DirectionalLight> m_lights;
+  std::vector<int> m_directional_index;
+  std::vector<char> m_g_constant;  // per material
+  int m_max_bounces = -1;
+  bool m_wavelength_independent = false;
+};
+
+// Largest value of a piecewise-linear spectrum over [lo_nm, hi_nm] (at the ends and the table's
+// breakpoints inside).
+double spectrum_max_over(const spectral::Spectrum& s, double lo_nm, double hi_nm);
+
+}  // namespace prizma::render

@@ -1,0 +1,104 @@
+#include "prizma/render/majorant_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace prizma::render {
+
+MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma_t_max, int cell_voxels)
+    : m_min(medium.bounds_min), m_max_corner(medium.bounds_max) {
+  const auto& d = medium.dims;
+  for (int a = 0; a < 3; ++a) m_cells[a] = cell_voxels > 0 ? (d[a] + cell_voxels - 1) / cell_voxels : 1;
+  // Cells are aligned with voxel boundaries, so a cell's majorant bounds exactly the voxels it holds;
+  // the last cell along an axis may hold fewer voxels and extends only to the box's edge.
+  std::array<int, 3> span{};
+  for (int a = 0; a < 3; ++a) {
+    span[a] = cell_voxels > 0 ? cell_voxels : d[a];
+    const double voxel = (m_max_corner[a] - m_min[a]) / d[a];
+    m_cell_size[a] = voxel * span[a];
+  }
+  m_majorant.assign(static_cast<std::size_t>(m_cells[0]) * m_cells[1] * m_cells[2], 0.0f);
+  for (int z = 0; z < d[2]; ++z)
+    for (int y = 0; y < d[1]; ++y)
+      for (int x = 0; x < d[0]; ++x) {
+        const std::size_t v = (static_cast<std::size_t>(z) * d[1] + y) * d[0] + x;
+        const std::uint16_t m = medium.material[v];
+        if (m == Medium::kEmpty) continue;
+        const float mu = medium.density[v] * sigma_t_max[m];
+        float& cell = m_majorant[(static_cast<std::size_t>(z / span[2]) * m_cells[1] + y / span[1]) * m_cells[0] +
+                                 x / span[0]];
+        cell = std::max(cell, mu);
+      }
+  for (float mu : m_majorant) m_max = std::max(m_max, mu);
+}
+
+bool intersect_box(const Ray& ray, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double& t_enter,
+                   double& t_exit) {
+  double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    const double inv = 1.0 / ray.direction[a];
+    double ta = (lo[a] - ray.origin[a]) * inv;
+    double tb = (hi[a] - ray.origin[a]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    // A ray parallel to a slab: inside gives (−inf, inf), outside (inf, inf) or NaN on the plane.
+    if (std::isnan(ta) || std::isnan(tb)) {
+      if (ray.origin[a] < lo[a] || ray.origin[a] > hi[a]) return false;
+      continue;
+    }
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  t_enter = t0;
+  t_exit = t1;
+  return t1 > t0;
+}
+
+MajorantTraversal::MajorantTraversal(const MajorantGrid& grid, const Ray& ray, double t_min, double t_max)
+    : m_grid(&grid), m_t(t_min), m_t_max(t_max) {
+  if (!(t_max > t_min)) return;
+  m_done = false;
+  const double t_mid = t_min + 1e-9 * (t_max - t_min);
+  for (int a = 0; a < 3; ++a) {
+    const double o = ray.origin[a], d = ray.direction[a];
+    const double cs = grid.cell_size()[a], lo = grid.bounds_min()[a];
+    const int n = grid.cells()[a];
+    m_cell[a] = std::clamp(static_cast<int>(std::floor((o + t_mid * d - lo) / cs)), 0, n - 1);
+    if (d > 0) {
+      m_step[a] = 1;
+      m_next_t[a] = (lo + (m_cell[a] + 1) * cs - o) / d;
+      m_delta_t[a] = cs / d;
+    } else if (d < 0) {
+      m_step[a] = -1;
+      m_next_t[a] = (lo + m_cell[a] * cs - o) / d;
+      m_delta_t[a] = -cs / d;
+    } else {
+      m_step[a] = 0;
+      m_next_t[a] = std::numeric_limits<double>::infinity();
+      m_delta_t[a] = 0;
+    }
+  }
+}
+
+bool MajorantTraversal::next(Segment& seg) {
+  if (m_done) return false;
+  int axis = 0;
+  if (m_next_t[1] < m_next_t[axis]) axis = 1;
+  if (m_next_t[2] < m_next_t[axis]) axis = 2;
+  const double t1 = std::min(m_next_t[axis], m_t_max);
+  seg.t0 = m_t;
+  seg.t1 = t1;
+  seg.cell = m_cell;
+  seg.majorant = m_grid->majorant(m_cell[0], m_cell[1], m_cell[2]);
+  m_t = t1;
+  if (m_next_t[axis] >= m_t_max) {
+    m_done = true;
+  } else {
+    m_cell[axis] += m_step[axis];
+    m_next_t[axis] += m_delta_t[axis];
+    if (m_cell[axis] < 0 || m_cell[axis] >= m_grid->cells()[axis]) m_done = true;
+  }
+  return true;
+}
+
+}  // namespace prizma::render

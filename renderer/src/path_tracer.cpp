@@ -1,0 +1,325 @@
+#include "prizma/render/path_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "prizma/render/phase.h"
+#include "prizma/spectral/error.h"
+
+namespace prizma::render {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Ratio tracking's Russian roulette: below this largest transmittance, stop with probability kRrStop.
+constexpr float kTransmittanceRrThreshold = 0.05f;
+constexpr float kTransmittanceRrStop = 0.75f;
+
+// Lanes known at compile time (1) or not (0 = scratch.lanes).
+template <int kLanes>
+int lane_count(const PathScratch& s) {
+  return kLanes > 0 ? kLanes : s.lanes;
+}
+
+}  // namespace
+
+double spectrum_max_over(const spectral::Spectrum& s, double lo_nm, double hi_nm) {
+  double m = std::max(s.eval(lo_nm), s.eval(hi_nm));
+  for (std::size_t k = 0; k < s.wavelengths_nm().size(); ++k) {
+    const double l = s.wavelengths_nm()[k];
+    if (l >= lo_nm && l <= hi_nm) m = std::max(m, s.values()[k]);
+  }
+  return m;
+}
+
+PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi_nm, bool use_grid)
+    : m_medium(&scene.medium), m_max_bounces(scene.settings.max_bounces) {
+  const Medium& med = scene.medium;
+  if (med.dims[0] < 1 || med.dims[1] < 1 || med.dims[2] < 1 || med.material.size() != med.voxel_count() ||
+      med.density.size() != med.voxel_count())
+    throw spectral::InputError("medium", "voxel arrays do not match dims");
+  for (int a = 0; a < 3; ++a) {
+    const double extent = med.bounds_max[a] - med.bounds_min[a];
+    if (!(extent > 0)) throw spectral::InputError("medium", "bounds must have positive extent");
+    m_inv_voxel[a] = med.dims[a] / extent;
+  }
+  std::vector<float> sigma_t_max(med.materials.size());
+  m_wavelength_independent = true;
+  for (std::size_t m = 0; m < med.materials.size(); ++m) {
+    const Material& mat = med.materials[m];
+    // Round the bound up by one float ulp so that σt at any wavelength never exceeds it.
+    const double smax = spectrum_max_over(mat.sigma_t_per_unit, lambda_lo_nm, lambda_hi_nm);
+    sigma_t_max[m] = std::nextafter(static_cast<float>(std::max(0.0, smax)), 1e30f);
+    m_g_constant.push_back(mat.anisotropy.is_constant() ? 1 : 0);
+    if (!mat.albedo.is_constant() || !mat.sigma_t_per_unit.is_constant() || !mat.anisotropy.is_constant())
+      m_wavelength_independent = false;
+  }
+  for (std::size_t v = 0; v < med.voxel_count(); ++v)
+    if (med.material[v] != Medium::kEmpty && med.material[v] >= med.materials.size())
+      throw spectral::InputError("medium", "voxel material index " + std::to_string(med.material[v]) +
+                                               " out of range");
+  m_grid = MajorantGrid(med, sigma_t_max, use_grid ? MajorantGrid::kCellVoxels : 0);
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    const Light& light = scene.lights[l];
+    if (light.direction.squaredNorm() == 0.0) continue;
+    DirectionalLight d;
+    d.direction = light.direction.normalized();
+    d.cos_max = light.angular_size_deg > 0 ? std::cos(0.5 * light.angular_size_deg * kPi / 180.0) : 1.0;
+    m_lights.push_back(d);
+    m_directional_index.push_back(static_cast<int>(l));
+  }
+}
+
+void PathTracer::prepare(PathScratch& s, int lanes) const {
+  const std::size_t n = static_cast<std::size_t>(lanes);
+  const std::size_t nm = m_medium->materials.size();
+  s.lanes = lanes;
+  s.lambda_nm.assign(n, 0.0f);
+  s.sigma_t.assign(nm * n, 0.0f);
+  s.albedo.assign(nm * n, 0.0f);
+  s.g.assign(nm * n, 0.0f);
+  s.material_stamp.assign(nm, 0);
+  s.path_id = 0;
+  for (auto* v : {&s.weight, &s.transmittance, &s.phase, &s.sigma_a, &s.sigma_s, &s.sigma_n, &s.environment})
+    v->assign(n, 0.0f);
+  s.directional.assign(m_lights.size() * n, 0.0f);
+}
+
+bool PathTracer::hits_medium(const Ray& ray) const {
+  double t0, t1;
+  return intersect_box(ray, m_medium->bounds_min, m_medium->bounds_max, t0, t1);
+}
+
+void PathTracer::evaluate_material(int m, PathScratch& s) const {
+  // Once per path and material: the spectra at the path's wavelengths, so that a collision costs a
+  // voxel lookup and a few multiplies.
+  const Material& mat = m_medium->materials[m];
+  const int n = s.lanes;
+  float* st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
+  float* al = s.albedo.data() + static_cast<std::size_t>(m) * n;
+  float* g = s.g.data() + static_cast<std::size_t>(m) * n;
+  for (int i = 0; i < n; ++i) {
+    const double l = s.lambda_nm[i];
+    st[i] = static_cast<float>(std::max(0.0, mat.sigma_t_per_unit.eval(l)));
+    al[i] = static_cast<float>(std::clamp(mat.albedo.eval(l), 0.0, 1.0));
+    g[i] = static_cast<float>(std::clamp(mat.anisotropy.eval(l), -0.9999, 0.9999));
+  }
+  s.material_stamp[m] = s.path_id;
+}
+
+void PathTracer::lookup(const Eigen::Vector3d& p, std::uint16_t& material, float& density) const {
+  const Medium& med = *m_medium;
+  int idx[3];
+  for (int a = 0; a < 3; ++a)
+    idx[a] = std::clamp(static_cast<int>((p[a] - med.bounds_min[a]) * m_inv_voxel[a]), 0, med.dims[a] - 1);
+  const std::size_t v = (static_cast<std::size_t>(idx[2]) * med.dims[1] + idx[1]) * med.dims[0] + idx[0];
+  material = med.material[v];
+  density = med.density[v];
+}
+
+void PathTracer::trace(const Ray& ray, Rng& rng, PathScratch& s) const {
+  if (s.lanes == 1)
+    trace_lanes<1>(ray, rng, s);
+  else
+    trace_lanes<0>(ray, rng, s);
+}
+
+template <int kLanes>
+void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng,
+                               PathScratch& s) const {
+  // Ratio tracking (Novák, Selle, Jarosz 2014) against the cell majorants, every lane at once:
+  // T *= 1 − σt/μ̄ at each tentative collision, with Russian roulette once T is small.
+  const int n = lane_count<kLanes>(s);
+  float* __restrict T = s.transmittance.data();
+  for (int i = 0; i < n; ++i) T[i] = 1.0f;
+  const Ray ray{origin, dir};
+  double t_enter, t_exit;
+  if (!intersect_box(ray, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) return;
+  MajorantTraversal walk(m_grid, ray, t_enter, t_exit);
+  MajorantTraversal::Segment seg;
+  while (walk.next(seg)) {
+    ++s.counters.majorant_cells;
+    if (seg.majorant <= 0.0f) continue;
+    const float inv_mu = 1.0f / seg.majorant;
+    double t = seg.t0;
+    for (;;) {
+      t -= std::log(rng.uniform()) * inv_mu;
+      if (t >= seg.t1) break;
+      ++s.counters.shadow_steps;
+      std::uint16_t m;
+      float d;
+      lookup(origin + t * dir, m, d);
+      if (m == Medium::kEmpty || d <= 0.0f) continue;
+      if (s.material_stamp[m] != s.path_id) evaluate_material(m, s);
+      const float* __restrict st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
+      const float scale = d * inv_mu;
+      float tmax = 0.0f;
+      for (int i = 0; i < n; ++i) {
+        T[i] *= std::max(0.0f, 1.0f - scale * st[i]);
+        tmax = std::max(tmax, T[i]);
+      }
+      if (tmax < kTransmittanceRrThreshold) {
+        if (rng.uniform() < kTransmittanceRrStop) {
+          for (int i = 0; i < n; ++i) T[i] = 0.0f;
+          return;
+        }
+        const float k = 1.0f / (1.0f - kTransmittanceRrStop);
+        for (int i = 0; i < n; ++i) T[i] *= k;
+      }
+    }
+  }
+}
+
+template <int kLanes>
+void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) const {
+  const int n = lane_count<kLanes>(s);
+  ++s.path_id;
+  if (s.path_id == 0) {  // wrapped: forget every stamp
+    std::fill(s.material_stamp.begin(), s.material_stamp.end(), 0u);
+    s.path_id = 1;
+  }
+  float* __restrict w = s.weight.data();
+  float* __restrict env = s.environment.data();
+  float* __restrict sa = s.sigma_a.data();
+  float* __restrict ss = s.sigma_s.data();
+  float* __restrict sn = s.sigma_n.data();
+  float* __restrict f = s.phase.data();
+  for (int i = 0; i < n; ++i) {
+    w[i] = 1.0f;
+    env[i] = 0.0f;
+  }
+  std::fill(s.directional.begin(), s.directional.end(), 0.0f);
+
+  Eigen::Vector3d pos = camera_ray.origin;
+  Eigen::Vector3d dir = camera_ray.direction;
+  double t_enter, t_exit;
+  if (!intersect_box(camera_ray, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) {
+    for (int i = 0; i < n; ++i) env[i] = 1.0f;
+    return;
+  }
+  ++s.counters.paths_in_volume;
+  int bounces = 0;
+  for (;;) {
+    // Free flight: delta tracking with spectral tracking's event probabilities (Kutz et al. 2017,
+    // "max" history-aware scheme): P_e ∝ max_i |w_i σ_e,i| for e ∈ {absorb, scatter, null}, and
+    // each lane's weight multiplied by σ_e,i / (μ̄ P_e). With one lane this is analog delta tracking.
+    const Ray ray{pos, dir};
+    MajorantTraversal walk(m_grid, ray, t_enter, t_exit);
+    MajorantTraversal::Segment seg;
+    bool scattered = false;
+    int material = 0;
+    while (!scattered && walk.next(seg)) {
+      ++s.counters.majorant_cells;
+      if (seg.majorant <= 0.0f) continue;
+      const float mu = seg.majorant;
+      const float inv_mu = 1.0f / mu;
+      double t = seg.t0;
+      for (;;) {
+        t -= std::log(rng.uniform()) * inv_mu;
+        if (t >= seg.t1) break;
+        ++s.counters.collisions;
+        const Eigen::Vector3d p = pos + t * dir;
+        std::uint16_t m;
+        float d;
+        lookup(p, m, d);
+        if (m == Medium::kEmpty || d <= 0.0f) continue;  // σt = 0: a null collision of weight 1
+        if (s.material_stamp[m] != s.path_id) evaluate_material(m, s);
+        const float* __restrict st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
+        const float* __restrict al = s.albedo.data() + static_cast<std::size_t>(m) * n;
+        float ma = 0.0f, ms = 0.0f, mn = 0.0f;
+        for (int i = 0; i < n; ++i) {
+          const float sig_t = d * st[i];
+          ss[i] = sig_t * al[i];
+          sa[i] = sig_t - ss[i];
+          sn[i] = std::max(0.0f, mu - sig_t);
+          ma = std::max(ma, w[i] * sa[i]);
+          ms = std::max(ms, w[i] * ss[i]);
+          mn = std::max(mn, w[i] * sn[i]);
+        }
+        const float c = ma + ms + mn;
+        if (!(c > 0.0f)) return;
+        const float xi = rng.uniform() * c;
+        if (xi < ma) return;  // absorbed: no emission, the path ends
+        if (xi < ma + ms) {
+          const float k = c / (mu * ms);
+          for (int i = 0; i < n; ++i) w[i] *= ss[i] * k;
+          pos = p;
+          material = m;
+          scattered = true;
+          break;
+        }
+        const float k = c / (mu * mn);
+        for (int i = 0; i < n; ++i) w[i] *= sn[i] * k;
+      }
+    }
+    if (!scattered) {
+      // Escaped: the unit environment is seen with the path's weight.
+      for (int i = 0; i < n; ++i) env[i] += w[i];
+      return;
+    }
+    if (m_max_bounces >= 0 && bounces >= m_max_bounces) return;
+    ++bounces;
+
+    const float* __restrict g = s.g.data() + static_cast<std::size_t>(material) * n;
+    const bool g_constant = kLanes == 1 || m_g_constant[material];
+
+    // Next-event estimation of every directional light: direction (delta, or uniform in the cone
+    // with radiance 1/Ω, so the estimate is phase × transmittance either way), transmittance by
+    // ratio tracking to the box's exit.
+    for (std::size_t l = 0; l < m_lights.size(); ++l) {
+      const DirectionalLight& light = m_lights[l];
+      Eigen::Vector3d wl = light.direction;
+      if (light.cos_max < 1.0) {
+        const double cos_t = 1.0 - rng.uniform_double() * (1.0 - light.cos_max);
+        wl = direction_around(light.direction, cos_t, rng.uniform_double());
+      }
+      const auto cos_theta = static_cast<float>(dir.dot(wl));
+      transmittance<kLanes>(pos, wl, rng, s);
+      const float* __restrict T = s.transmittance.data();
+      float* __restrict out = s.directional.data() + l * static_cast<std::size_t>(n);
+      if (g_constant) {
+        const float p = hg_phase(cos_theta, g[0]);
+        for (int i = 0; i < n; ++i) out[i] += w[i] * p * T[i];
+      } else {
+        for (int i = 0; i < n; ++i) out[i] += w[i] * hg_phase(cos_theta, g[i]) * T[i];
+      }
+    }
+
+    // New direction from the phase function. With g varying across lanes: sample one lane's lobe
+    // chosen uniformly (one-sample MIS over lanes), weight each lane by p_i / mean_j p_j.
+    float cos_theta;
+    if (g_constant) {
+      cos_theta = hg_sample_cos(g[0], rng.uniform());
+    } else {
+      const int j = std::min(n - 1, static_cast<int>(rng.uniform() * static_cast<float>(n)));
+      cos_theta = hg_sample_cos(g[j], rng.uniform());
+      float sum = 0.0f;
+      for (int i = 0; i < n; ++i) {
+        f[i] = hg_phase(cos_theta, g[i]);
+        sum += f[i];
+      }
+      const float inv_pdf = static_cast<float>(n) / sum;
+      for (int i = 0; i < n; ++i) w[i] *= f[i] * inv_pdf;
+    }
+    dir = direction_around(dir, cos_theta, rng.uniform_double()).normalized();
+
+    // Russian roulette on the largest lane weight (unbiased: survivors divided by the probability).
+    float wmax = 0.0f;
+    for (int i = 0; i < n; ++i) wmax = std::max(wmax, w[i]);
+    if (!(wmax > 0.0f)) return;
+    if (wmax < 1.0f) {
+      if (rng.uniform() >= wmax) return;
+      const float k = 1.0f / wmax;
+      for (int i = 0; i < n; ++i) w[i] *= k;
+    }
+    const Ray next{pos, dir};
+    if (!intersect_box(next, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) {
+      for (int i = 0; i < n; ++i) env[i] += w[i];
+      return;
+    }
+  }
+}
+
+template void PathTracer::trace_lanes<1>(const Ray&, Rng&, PathScratch&) const;
+template void PathTracer::trace_lanes<0>(const Ray&, Rng&, PathScratch&) const;
+
+}  // namespace prizma::render

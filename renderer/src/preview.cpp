@@ -1,0 +1,52 @@
+// write_preview(): an 8-bit sRGB picture of a transport image under its lights' default spectra.
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+
+#include "prizma/render/render.h"
+#include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/colour.h"
+#include "prizma/spectral/colour_matching.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/spectrum_spec.h"
+
+namespace prizma::render {
+
+void write_preview(const std::filesystem::path& path, const spectral::SpectralImage& image,
+                   const std::vector<Light>& lights, const PreviewOptions& opts) {
+  const int nb = image.bins.size();
+  const auto& cmf = spectral::ColorMatching::get(spectral::Observer::Cie1931_2deg);
+  // Per light: 3×n weights of its default spectrum, relative to white (exact bin integrals).
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> weights;
+  for (std::size_t l = 0; l < image.lights.size(); ++l) {
+    std::string spec = "D65";
+    for (const Light& light : lights)
+      if (light.name == image.lights[l].name) spec = light.spectrum_spec;
+    spectral::SpecContext ctx{"lights[" + std::to_string(l) + "].spectrum", opts.spectrum_base_dir};
+    weights.push_back(spectral::relight_weights(cmf, spectral::parse_spectrum(spec, ctx), image.bins));
+  }
+  const double scale = std::exp2(opts.exposure_ev);
+  const std::size_t pixels = image.pixel_count();
+  std::vector<unsigned char> rgb8(pixels * 3);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+    for (std::size_t l = 0; l < image.lights.size(); ++l) {
+      const float* t = image.lights[l].data.data() + p * nb;
+      for (int i = 0; i < nb; ++i) xyz += weights[l].col(i) * static_cast<double>(t[i]);
+    }
+    const Eigen::Vector3d lin = spectral::xyz_to_linear_srgb(xyz * scale);
+    for (int c = 0; c < 3; ++c) {
+      const double e = std::clamp(spectral::srgb_encode(std::clamp(lin[c], 0.0, 1.0)), 0.0, 1.0);
+      rgb8[p * 3 + c] = static_cast<unsigned char>(std::lround(e * 255.0));
+    }
+  }
+  spectral::write_atomically(path, [&](const std::filesystem::path& tmp) {
+    auto out = OIIO::ImageOutput::create(tmp.string());
+    if (!out) throw spectral::RuntimeError(path.string() + ": cannot write this format: " + OIIO::geterror());
+    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+    if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb8.data()) || !out->close())
+      throw spectral::RuntimeError(path.string() + ": " + out->geterror());
+  });
+}
+
+}  // namespace prizma::render

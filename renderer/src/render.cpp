@@ -1,0 +1,294 @@
+// render(): passes of samples over the image, each pixel's samples accumulated in sample order in
+// double, so the result does not depend on threads or tiling.
+#include "prizma/render/render.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "prizma/render/camera.h"
+#include "prizma/render/path_tracer.h"
+#include "prizma/render/rng.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/spectrum_spec.h"
+#include "prizma/spectral/tool_main.h"
+
+namespace prizma::render {
+namespace {
+
+using spectral::InputError;
+
+// Adaptive sampling looks at a pixel's error only after this many samples.
+constexpr std::int64_t kMinAdaptiveSamples = 16;
+// Automatic pass size: about this many paths per pass.
+constexpr std::int64_t kPathsPerPass = std::int64_t{1} << 20;
+
+enum class LaneMode { AllBins, Replicated, Single };
+
+struct ThreadState {
+  PathScratch path;
+  std::vector<double> value;  // [light][bin] of one sample
+  std::int64_t paths = 0;
+  std::int64_t nan_or_inf = 0;
+  std::int64_t converged = 0;
+};
+
+}  // namespace
+
+std::string wavelength_sampling_name(WavelengthSampling w) {
+  return w == WavelengthSampling::Single ? "single" : "spectral-tracking";
+}
+
+WavelengthSampling parse_wavelength_sampling(std::string_view name, std::string_view input) {
+  if (name == "spectral-tracking") return WavelengthSampling::SpectralTracking;
+  if (name == "single") return WavelengthSampling::Single;
+  throw InputError(std::string(input),
+                   "unknown wavelength sampling \"" + std::string(name) + "\" (known: spectral-tracking, single)");
+}
+
+spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callbacks, RenderStats* stats_out) {
+  const auto start = std::chrono::steady_clock::now();
+  const RenderSettings& st = scene.settings;
+  const spectral::BinLayout& bins = st.bins;
+  const int nb = bins.size();
+  if (nb < 1) throw InputError("bins", "no bins");
+  if (st.sample_begin < 0 || st.sample_end <= st.sample_begin)
+    throw InputError("samples", "empty or negative sample range " + std::to_string(st.sample_begin) + ":" +
+                                    std::to_string(st.sample_end));
+  if (scene.lights.empty()) throw InputError("lights", "the scene has no lights");
+  if (!(st.target_error >= 0.0) || !std::isfinite(st.target_error))
+    throw InputError("target_error", "must be ≥ 0, got " + std::to_string(st.target_error));
+
+  const CameraModel camera(scene.camera);
+  const PathTracer tracer(scene, bins.min_nm(), bins.max_nm(), st.use_majorant_grid);
+  const int width = camera.width(), height = camera.height();
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  const int nl = static_cast<int>(scene.lights.size());
+
+  LaneMode mode = LaneMode::AllBins;
+  if (st.wavelength_sampling == WavelengthSampling::Single)
+    mode = LaneMode::Single;
+  else if (tracer.wavelength_independent())
+    mode = LaneMode::Replicated;
+  const int lanes = mode == LaneMode::AllBins ? nb : 1;
+
+  // Where each light's per-lane radiance comes from: the environment (−1) or a directional light.
+  std::vector<int> source(nl, -1);
+  for (std::size_t k = 0; k < tracer.directional_lights().size(); ++k)
+    source[tracer.directional_lights()[k]] = static_cast<int>(k);
+
+  // Test/benchmark mode: lights folded in with their default spectra.
+  std::vector<spectral::Spectrum> fold;
+  if (st.fold_light_spectra) {
+    spectral::SpecContext ctx;
+    if (!scene.source.empty()) ctx.base_dir = scene.source.parent_path();
+    for (int l = 0; l < nl; ++l) {
+      ctx.input = "lights[" + std::to_string(l) + "].spectrum";
+      fold.push_back(spectral::parse_spectrum(scene.lights[l].spectrum_spec, ctx));
+    }
+  }
+
+  // Accumulators: per pixel, light and bin, in double.
+  const std::size_t per_pixel = static_cast<std::size_t>(nl) * nb;
+  const bool adaptive = st.target_error > 0.0;
+  const bool keep_squares = st.write_variance;
+  std::vector<double> sum(pixels * per_pixel, 0.0);
+  std::vector<double> sum_sq(keep_squares ? pixels * per_pixel : 0, 0.0);
+  std::vector<double> total_sum(adaptive ? pixels : 0, 0.0), total_sq(adaptive ? pixels : 0, 0.0);
+  std::vector<std::int64_t> count(pixels, 0);
+  std::vector<char> converged(pixels, 0);
+
+  tbb::enumerable_thread_specific<ThreadState> states([&] {
+    ThreadState t;
+    tracer.prepare(t.path, lanes);
+    t.value.assign(per_pixel, 0.0);
+    return t;
+  });
+
+  const std::int64_t total = st.sample_end - st.sample_begin;
+  std::int64_t per_pass = callbacks.samples_per_pass;
+  if (per_pass <= 0) per_pass = std::max<std::int64_t>(1, kPathsPerPass / static_cast<std::int64_t>(pixels));
+  per_pass = std::min(per_pass, total);
+
+  auto render_pixel = [&](ThreadState& ts, int x, int y, std::int64_t s0, std::int64_t s1) {
+    const std::size_t pix = static_cast<std::size_t>(y) * width + x;
+    if (converged[pix]) return;
+    double* acc = sum.data() + pix * per_pixel;
+    double* acc_sq = keep_squares ? sum_sq.data() + pix * per_pixel : nullptr;
+    PathScratch& ps = ts.path;
+    double* v = ts.value.data();
+    for (std::int64_t s = s0; s < s1; ++s) {
+      Rng rng(st.seed, pix, static_cast<std::uint64_t>(s));
+      const double px = x + rng.uniform_double();
+      const double py = y + rng.uniform_double();
+      const Ray ray = camera.generate(px, py);
+      // Wavelengths: one jitter u shared by all bins, λ_i = lo_i + u·Δλ_i; Single picks one bin.
+      const double u = rng.uniform_double();
+      int bin = 0;
+      if (mode == LaneMode::Single) {
+        bin = std::min(nb - 1, static_cast<int>(rng.uniform_double() * nb));
+        ps.lambda_nm[0] = static_cast<float>(bins.lo_nm(bin) + u * bins.width_nm(bin));
+      } else if (mode == LaneMode::AllBins) {
+        for (int i = 0; i < nb; ++i) ps.lambda_nm[i] = static_cast<float>(bins.lo_nm(i) + u * bins.width_nm(i));
+      } else {
+        ps.lambda_nm[0] = static_cast<float>(bins.centre_nm(0));
+      }
+      tracer.trace(ray, rng, ps);
+      ++ts.paths;
+
+      // Lanes → (light, bin) values of this sample.
+      bool finite = true;
+      for (int l = 0; l < nl; ++l) {
+        const float* src = source[l] < 0 ? ps.environment.data()
+                                         : ps.directional.data() + static_cast<std::size_t>(source[l]) * lanes;
+        double* out = v + static_cast<std::size_t>(l) * nb;
+        switch (mode) {
+          case LaneMode::AllBins:
+            for (int i = 0; i < nb; ++i) out[i] = src[i];
+            break;
+          case LaneMode::Replicated:
+            for (int i = 0; i < nb; ++i) out[i] = src[0];
+            break;
+          case LaneMode::Single:
+            for (int i = 0; i < nb; ++i) out[i] = 0.0;
+            out[bin] = static_cast<double>(src[0]) * nb;  // one bin of n drawn: weight n
+            break;
+        }
+        if (!fold.empty()) {
+          if (mode == LaneMode::Single) {
+            out[bin] *= fold[l].eval(bins.lo_nm(bin) + u * bins.width_nm(bin));
+          } else {
+            for (int i = 0; i < nb; ++i) out[i] *= fold[l].eval(bins.lo_nm(i) + u * bins.width_nm(i));
+          }
+        }
+        for (int i = 0; i < nb; ++i) finite = finite && std::isfinite(out[i]);
+      }
+      if (!finite) {
+        // Never let a NaN/Inf reach the image: count it, take the sample as 0.
+        ++ts.nan_or_inf;
+        std::fill(v, v + per_pixel, 0.0);
+      }
+      double sample_total = 0.0;
+      for (std::size_t k = 0; k < per_pixel; ++k) {
+        acc[k] += v[k];
+        sample_total += v[k];
+      }
+      if (acc_sq)
+        for (std::size_t k = 0; k < per_pixel; ++k) acc_sq[k] += v[k] * v[k];
+      const std::int64_t nsamp = ++count[pix];
+      if (adaptive) {
+        total_sum[pix] += sample_total;
+        total_sq[pix] += sample_total * sample_total;
+        if (nsamp >= kMinAdaptiveSamples) {
+          const double n = static_cast<double>(nsamp);
+          const double mean = total_sum[pix] / n;
+          const double var = std::max(0.0, (total_sq[pix] / n - mean * mean) * n / (n - 1.0));
+          if (std::sqrt(var / n) <= st.target_error * std::abs(mean)) {
+            converged[pix] = 1;
+            ++ts.converged;
+            return;
+          }
+        }
+      }
+    }
+  };
+
+  std::optional<tbb::task_arena> arena;
+  if (st.threads > 0) arena.emplace(st.threads);
+  auto run_pass = [&](std::int64_t s0, std::int64_t s1) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+      ThreadState& ts = states.local();
+      for (int y = rows.begin(); y != rows.end(); ++y)
+        for (int x = 0; x < width; ++x) render_pixel(ts, x, y, s0, s1);
+    });
+  };
+
+  std::int64_t done = 0;
+  bool interrupted = false;
+  while (done < total) {
+    if (callbacks.cancel && callbacks.cancel->load()) {
+      interrupted = true;
+      break;
+    }
+    const std::int64_t s0 = st.sample_begin + done;
+    const std::int64_t s1 = std::min(st.sample_end, s0 + per_pass);
+    if (arena)
+      arena->execute([&] { run_pass(s0, s1); });
+    else
+      run_pass(s0, s1);
+    done = s1 - st.sample_begin;
+    if (callbacks.progress) {
+      RenderProgress p;
+      p.samples_done = done;
+      p.samples_total = total;
+      for (const auto& t : states) p.paths += t.paths;
+      p.elapsed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      callbacks.progress(p);
+    }
+  }
+  if (done < total && !interrupted) interrupted = true;
+  if (done == 0) throw spectral::RuntimeError("render interrupted before the first pass completed");
+
+  // The image: per-pixel means (and variances of the mean) as float.
+  spectral::SpectralImage img;
+  img.width = width;
+  img.height = height;
+  img.bins = bins;
+  img.lights.resize(nl);
+  for (int l = 0; l < nl; ++l) {
+    auto& layer = img.lights[l];
+    layer.name = scene.lights[l].name;
+    layer.data.assign(pixels * nb, 0.0f);
+    if (keep_squares) layer.variance.assign(pixels * nb, 0.0f);
+  }
+  for (std::size_t pix = 0; pix < pixels; ++pix) {
+    const double n = static_cast<double>(count[pix]);
+    for (int l = 0; l < nl; ++l) {
+      auto& layer = img.lights[l];
+      for (int i = 0; i < nb; ++i) {
+        const std::size_t k = pix * per_pixel + static_cast<std::size_t>(l) * nb + i;
+        const double mean = n > 0 ? sum[k] / n : 0.0;
+        layer.data[pix * nb + i] = static_cast<float>(mean);
+        if (keep_squares && n > 1) {
+          const double var = std::max(0.0, (sum_sq[k] / n - mean * mean) * n / (n - 1.0));
+          layer.variance[pix * nb + i] = static_cast<float>(var / n);
+        }
+      }
+    }
+  }
+  img.info.is_prizma = true;
+  img.info.lights_json = lights_to_json(scene.lights);
+  img.info.samples = done;
+  img.info.sample_range = std::to_string(st.sample_begin) + ":" + std::to_string(st.sample_begin + done);
+  img.info.seed = static_cast<std::int64_t>(st.seed);
+  img.info.scene_hash = scene.hash;
+  img.info.version = spectral::prizma_version();
+  img.info.wavelength_sampling = wavelength_sampling_name(st.wavelength_sampling);
+
+  if (stats_out) {
+    RenderStats s;
+    for (const auto& t : states) {
+      s.paths += t.paths;
+      s.nan_or_inf_count += t.nan_or_inf;
+      s.pixels_converged += t.converged;
+      s.paths_in_volume += t.path.counters.paths_in_volume;
+      s.collisions += t.path.counters.collisions;
+      s.shadow_steps += t.path.counters.shadow_steps;
+      s.majorant_cells += t.path.counters.majorant_cells;
+    }
+    s.samples_completed = done;
+    s.interrupted = interrupted;
+    s.wavelength_independent = mode == LaneMode::Replicated;
+    s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    *stats_out = s;
+  }
+  return img;
+}
+
+}  // namespace prizma::render
