@@ -1,0 +1,589 @@
+// The spectral OpenEXR layout (docs/spectral-exr.md), read and written through OpenEXR's C++ API.
+// Fichet, Pacanowski, Wilkie, "An OpenEXR Layout for Spectral Images", JCGT 10(3), 2021: reflective
+// channels T.<λ>nm (comma decimal separator), spectralLayoutVersion "1.0". Prizma adds one layer per
+// light (when there are two or more), variance layers and prizma: attributes.
+#include "prizma/spectral/spectral_exr.h"
+
+#include <ImathBox.h>
+#include <ImfChannelList.h>
+#include <ImfFloatVectorAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+#include <ImfTestFile.h>
+#include <half.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <list>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/tool_main.h"
+#include "text_util.h"
+
+namespace prizma::spectral {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kLayoutVersion = "1.0";
+constexpr const char* kAttrEdges = "prizma:binEdgesNm";
+// The same edges as decimal text with 17 significant digits: the float vector above loses the
+// double precision of BinLayout, this restores it exactly (readers that do not know it ignore it).
+constexpr const char* kAttrEdgesExact = "prizma:binEdgesNmExact";
+constexpr const char* kAttrLights = "prizma:lights";
+constexpr const char* kAttrSamples = "prizma:samples";
+constexpr const char* kAttrSampleRange = "prizma:sampleRange";
+constexpr const char* kAttrSeed = "prizma:seed";
+constexpr const char* kAttrSceneHash = "prizma:sceneHash";
+constexpr const char* kAttrVersion = "prizma:version";
+constexpr const char* kAttrWavelengthSampling = "prizma:wavelengthSampling";
+constexpr const char* kVarianceLayer = "var";
+constexpr float kHalfMax = 65504.0f;
+constexpr double kSpeedOfLight_m_per_s = 299792458.0;
+
+std::string path_string(const fs::path& p) { return p.string(); }
+
+int io_threads() {
+  const unsigned hc = std::thread::hardware_concurrency();
+  return static_cast<int>(std::clamp(hc, 1u, 8u));
+}
+
+bool valid_light_name(std::string_view name) {
+  if (name.empty()) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Channel names
+
+struct ParsedChannel {
+  std::string layer;  // text before the spectral part ("" for top level, "key", "key.var", "var")
+  bool emissive = false;
+  double lambda_nm = 0.0;
+};
+
+double unit_prefix_factor(const std::string& prefix) {
+  static const std::map<std::string, double> kFactors = {
+      {"Y", 1e24}, {"Z", 1e21}, {"E", 1e18}, {"P", 1e15}, {"T", 1e12}, {"G", 1e9},  {"M", 1e6},  {"k", 1e3},
+      {"h", 1e2},  {"da", 1e1}, {"", 1.0},   {"d", 1e-1}, {"c", 1e-2}, {"m", 1e-3}, {"u", 1e-6}, {"n", 1e-9},
+      {"p", 1e-12}};
+  return kFactors.at(prefix);
+}
+
+// The reference reader's pattern (JCGT 2021, section 3), with an optional layer prefix in front:
+//   ^((S([0-3]))|T)\.(\d*,?\d*([Ee][+-]?\d+)?)(Y|Z|E|P|T|G|M|k|h|da|d|c|m|u|n|p)?(m|Hz)$
+// Returns nullopt for channels that are not spectral (R, G, B, …). Throws InputError for a spectral
+// channel whose number is not a positive finite wavelength.
+std::optional<ParsedChannel> parse_channel_name(const std::string& name, const std::string& path) {
+  static const std::regex kPattern(
+      R"(^(?:(.+)\.)?(S[0-3]|T)\.(\d*,?\d*(?:[Ee][+-]?\d+)?)(Y|Z|E|P|T|G|M|k|h|da|d|c|m|u|n|p)?(m|Hz)$)");
+  std::smatch m;
+  if (!std::regex_match(name, m, kPattern)) return std::nullopt;
+  ParsedChannel out;
+  out.layer = m[1].matched ? m[1].str() : std::string();
+  out.emissive = m[2].str() != "T";
+  std::string number = m[3].str();
+  std::replace(number.begin(), number.end(), ',', '.');
+  double value = 0.0;
+  if (!detail::parse_double(number, value) || !std::isfinite(value) || value <= 0.0) {
+    throw InputError(path, "channel \"" + name + "\": \"" + m[3].str() + "\" is not a positive wavelength");
+  }
+  value *= unit_prefix_factor(m[4].matched ? m[4].str() : std::string());
+  // Metres → nm, or frequency in Hz → wavelength λ = c / f.
+  out.lambda_nm = (m[5].str() == "Hz") ? kSpeedOfLight_m_per_s / value * 1e9 : value * 1e9;
+  if (!std::isfinite(out.lambda_nm) || out.lambda_nm <= 0.0) {
+    throw InputError(path, "channel \"" + name + "\": wavelength out of range");
+  }
+  return out;
+}
+
+std::string layer_prefix(std::string_view layer) { return layer.empty() ? std::string() : std::string(layer) + "."; }
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+void check_finite(const std::vector<float>& values, int width, int bins, const std::string& what,
+                  const std::string& path) {
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (!std::isfinite(values[k])) {
+      const std::size_t pixel = k / static_cast<std::size_t>(bins);
+      std::ostringstream os;
+      os << what << ": " << (std::isnan(values[k]) ? "NaN" : "infinite value") << " at pixel ("
+         << pixel % static_cast<std::size_t>(width) << ", " << pixel / static_cast<std::size_t>(width) << "), bin "
+         << k % static_cast<std::size_t>(bins);
+      throw InputError(path, os.str());
+    }
+  }
+}
+
+std::string default_lights_json(const SpectralImage& image) {
+  nlohmann::json arr = nlohmann::json::array();
+  for (const auto& l : image.lights) arr.push_back({{"name", l.name}});
+  return arr.dump();
+}
+
+void put_int_or_string(Imf::Header& header, const char* name, std::int64_t v) {
+  if (v >= std::numeric_limits<int>::min() && v <= std::numeric_limits<int>::max()) {
+    header.insert(name, Imf::IntAttribute(static_cast<int>(v)));
+  } else {
+    header.insert(name, Imf::StringAttribute(std::to_string(v)));
+  }
+}
+
+// One channel set to write: a name prefix and a pixel-major, bin-contiguous float buffer.
+struct OutLayer {
+  std::string prefix;  // "" / "key." / "var." / "key.var."
+  const std::vector<float>* data;
+  std::string what;    // for messages
+};
+
+}  // namespace
+
+int SpectralImage::find_light(std::string_view name) const {
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    if (lights[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::string spectral_channel_name(double lambda_nm, std::string_view layer) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, lambda_nm, std::chars_format::fixed, 6);
+  std::string number(buf, res.ptr);
+  std::replace(number.begin(), number.end(), '.', ',');
+  return layer_prefix(layer) + "T." + number + "nm";
+}
+
+void write_spectral_exr(const fs::path& path, const SpectralImage& image, const ExrWriteOptions& opts) {
+  const std::string p = path_string(path);
+  // Validate the image: sizes, names, finite values.
+  if (image.width <= 0 || image.height <= 0) {
+    throw InputError(p, "image size " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                            " is empty");
+  }
+  if (image.lights.empty()) throw InputError(p, "the image has no light layers");
+  const int bins = image.bins.size();
+  const std::size_t expected = image.pixel_count() * static_cast<std::size_t>(bins);
+  std::set<std::string> names;
+  for (const auto& light : image.lights) {
+    if (!valid_light_name(light.name)) {
+      throw InputError(p, "light name \"" + light.name + "\" is not valid (letters, digits, '_' and '-' only)");
+    }
+    if (light.name == kVarianceLayer) {
+      throw InputError(p, "light name \"var\" is reserved for variance layers");
+    }
+    if (!names.insert(light.name).second) throw InputError(p, "two lights are named \"" + light.name + "\"");
+    if (light.data.size() != expected) {
+      throw InputError(p, "light \"" + light.name + "\" has " + std::to_string(light.data.size()) +
+                              " values, expected width·height·bins = " + std::to_string(expected));
+    }
+    if (!light.variance.empty() && light.variance.size() != expected) {
+      throw InputError(p, "light \"" + light.name + "\" has " + std::to_string(light.variance.size()) +
+                              " variance values, expected " + std::to_string(expected));
+    }
+    check_finite(light.data, image.width, bins, "light \"" + light.name + "\"", p);
+    if (opts.write_variance) check_finite(light.variance, image.width, bins, "variance of light \"" + light.name + "\"", p);
+  }
+
+  // The layers: top level (sum of all lights), per light when there are two or more, variance.
+  const bool multi = image.lights.size() >= 2;
+  std::vector<float> sum;
+  std::vector<OutLayer> layers;
+  if (multi) {
+    sum.assign(expected, 0.0f);
+    for (std::size_t k = 0; k < expected; ++k) {
+      double s = 0.0;
+      for (const auto& light : image.lights) s += light.data[k];
+      sum[k] = static_cast<float>(s);
+    }
+    check_finite(sum, image.width, bins, "sum of all lights", p);
+    layers.push_back({"", &sum, "sum of all lights"});
+    for (const auto& light : image.lights) layers.push_back({light.name + ".", &light.data, "light \"" + light.name + "\""});
+    if (opts.write_variance) {
+      for (const auto& light : image.lights) {
+        if (!light.variance.empty()) {
+          layers.push_back({light.name + ".var.", &light.variance, "variance of light \"" + light.name + "\""});
+        }
+      }
+    }
+  } else {
+    const auto& light = image.lights.front();
+    layers.push_back({"", &light.data, "light \"" + light.name + "\""});
+    if (opts.write_variance && !light.variance.empty()) {
+      layers.push_back({"var.", &light.variance, "variance of light \"" + light.name + "\""});
+    }
+  }
+
+  // Channel names, refusing two bins whose centres print the same.
+  std::vector<std::string> suffixes;
+  for (int i = 0; i < bins; ++i) suffixes.push_back(spectral_channel_name(image.bins.centre_nm(i)));
+  for (int i = 1; i < bins; ++i) {
+    if (suffixes[i] == suffixes[i - 1]) throw InputError(p, "two bins share the channel name " + suffixes[i]);
+  }
+
+  // Half: refuse (or clamp) values beyond half's range, then convert.
+  const bool half_out = opts.pixel_type == ExrPixelType::Half;
+  std::list<std::vector<half>> half_buffers;
+  if (half_out) {
+    std::size_t clamped = 0;
+    for (const auto& layer : layers) {
+      auto& hb = half_buffers.emplace_back(expected);
+      for (std::size_t k = 0; k < expected; ++k) {
+        float v = (*layer.data)[k];
+        if (std::fabs(v) > kHalfMax) {
+          if (!opts.clamp_half) {
+            throw InputError(p, layer.what + ": value " + std::to_string(v) +
+                                    " exceeds half's range (65504); write float, or clamp");
+          }
+          v = std::copysign(kHalfMax, v);
+          ++clamped;
+        }
+        hb[k] = half(v);
+      }
+    }
+    if (clamped > 0) {
+      std::cerr << "warning: " << p << ": " << clamped << " value" << (clamped == 1 ? "" : "s")
+                << " beyond half's range clamped to 65504\n";
+    }
+  }
+
+  // Header: channels and attributes.
+  Imf::Header header(image.width, image.height);
+  const Imf::PixelType type = half_out ? Imf::HALF : Imf::FLOAT;
+  for (const auto& layer : layers) {
+    for (int i = 0; i < bins; ++i) header.channels().insert(layer.prefix + suffixes[i], Imf::Channel(type));
+  }
+  header.insert("spectralLayoutVersion", Imf::StringAttribute(kLayoutVersion));
+  {
+    Imf::FloatVector edges;
+    std::string exact;
+    for (double e : image.bins.edges_nm()) {
+      edges.push_back(static_cast<float>(e));
+      char buf[64];
+      const auto res = std::to_chars(buf, buf + sizeof buf, e, std::chars_format::general, 17);
+      if (!exact.empty()) exact += ' ';
+      exact.append(buf, res.ptr);
+    }
+    header.insert(kAttrEdges, Imf::FloatVectorAttribute(edges));
+    header.insert(kAttrEdgesExact, Imf::StringAttribute(exact));
+  }
+  const SpectralExrInfo& info = image.info;
+  header.insert(kAttrLights, Imf::StringAttribute(info.lights_json.empty() ? default_lights_json(image)
+                                                                            : info.lights_json));
+  put_int_or_string(header, kAttrSamples, info.samples);
+  put_int_or_string(header, kAttrSeed, info.seed);
+  if (!info.sample_range.empty()) header.insert(kAttrSampleRange, Imf::StringAttribute(info.sample_range));
+  if (!info.scene_hash.empty()) header.insert(kAttrSceneHash, Imf::StringAttribute(info.scene_hash));
+  header.insert(kAttrVersion, Imf::StringAttribute(info.version.empty() ? prizma_version() : info.version));
+  if (!info.wavelength_sampling.empty()) {
+    header.insert(kAttrWavelengthSampling, Imf::StringAttribute(info.wavelength_sampling));
+  }
+
+  // Frame buffer: slices point straight into the pixel-major, bin-contiguous buffers (bin i of pixel
+  // (x, y) at base + i, x stride = bins values, y stride = width·bins values).
+  Imf::FrameBuffer fb;
+  const std::size_t elem = half_out ? sizeof(half) : sizeof(float);
+  const std::size_t x_stride = elem * static_cast<std::size_t>(bins);
+  const std::size_t y_stride = x_stride * static_cast<std::size_t>(image.width);
+  auto half_it = half_buffers.begin();
+  for (const auto& layer : layers) {
+    const char* base = half_out ? reinterpret_cast<const char*>((half_it++)->data())
+                                : reinterpret_cast<const char*>(layer.data->data());
+    for (int i = 0; i < bins; ++i) {
+      fb.insert(layer.prefix + suffixes[i],
+                Imf::Slice(type, const_cast<char*>(base + elem * static_cast<std::size_t>(i)), x_stride, y_stride));
+    }
+  }
+
+  write_atomically(path, [&](const fs::path& tmp) {
+    try {
+      Imf::OutputFile file(tmp.c_str(), header, io_threads());
+      file.setFrameBuffer(fb);
+      file.writePixels(image.height);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw RuntimeError(p + ": cannot write OpenEXR file: " + e.what());
+    }
+  });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading
+
+namespace {
+
+struct LayerChannels {
+  std::vector<std::pair<double, std::string>> channels;  // (λ nm, full channel name), sorted by λ
+  std::vector<double> lambdas() const {
+    std::vector<double> out;
+    for (const auto& c : channels) out.push_back(c.first);
+    return out;
+  }
+};
+
+const std::string* find_string_attr(const Imf::Header& h, const char* name) {
+  const auto* a = h.findTypedAttribute<Imf::StringAttribute>(name);
+  return a ? &a->value() : nullptr;
+}
+
+std::int64_t int_attr(const Imf::Header& h, const char* name, const std::string& path) {
+  if (const auto* a = h.findTypedAttribute<Imf::IntAttribute>(name)) return a->value();
+  if (const auto* s = find_string_attr(h, name)) {
+    std::int64_t v = 0;
+    const auto res = std::from_chars(s->data(), s->data() + s->size(), v);
+    if (res.ec != std::errc() || res.ptr != s->data() + s->size()) {
+      throw InputError(path, std::string(name) + ": \"" + *s + "\" is not an integer");
+    }
+    return v;
+  }
+  return 0;
+}
+
+std::string describe_lambdas(const std::vector<double>& l) {
+  std::ostringstream os;
+  os << l.size() << " channels";
+  if (!l.empty()) os << " " << l.front() << "–" << l.back() << " nm";
+  return os.str();
+}
+
+// Reads one layer's channels into a pixel-major, bin-contiguous buffer.
+void add_slices(Imf::FrameBuffer& fb, const LayerChannels& layer, std::vector<float>& dest,
+                const Imath::Box2i& dw, int bins) {
+  const std::size_t x_stride = sizeof(float) * static_cast<std::size_t>(bins);
+  const std::size_t y_stride = x_stride * static_cast<std::size_t>(dw.max.x - dw.min.x + 1);
+  for (int i = 0; i < bins; ++i) {
+    fb.insert(layer.channels[static_cast<std::size_t>(i)].second,
+              Imf::Slice::Make(Imf::FLOAT, dest.data() + i, dw, x_stride, y_stride));
+  }
+}
+
+}  // namespace
+
+SpectralImage read_spectral_exr(const fs::path& path) {
+  const std::string p = path_string(path);
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(p, "file does not exist");
+  if (fs::is_directory(path, ec)) throw InputError(p, "is a folder, not an OpenEXR file");
+  if (!Imf::isOpenExrFile(p.c_str())) throw InputError(p, "not an OpenEXR file");
+
+  try {
+    Imf::InputFile file(p.c_str(), io_threads());
+    const Imf::Header& header = file.header();
+    const Imath::Box2i dw = header.dataWindow();
+    SpectralImage image;
+    image.width = dw.max.x - dw.min.x + 1;
+    image.height = dw.max.y - dw.min.y + 1;
+    if (image.width <= 0 || image.height <= 0) throw InputError(p, "empty data window");
+
+    // Classify the channels into layers.
+    std::map<std::string, LayerChannels> layers;  // by layer prefix ("" = top level)
+    bool any_emissive = false;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      const auto parsed = parse_channel_name(it.name(), p);
+      if (!parsed) continue;
+      if (parsed->emissive) {
+        any_emissive = true;
+        continue;
+      }
+      layers[parsed->layer].channels.emplace_back(parsed->lambda_nm, it.name());
+    }
+    if (layers.empty()) {
+      if (any_emissive) {
+        throw InputError(p, "emissive-only spectral EXR (S0..S3 channels): Prizma reads reflective T.<λ>nm "
+                            "channels only");
+      }
+      throw InputError(p, "no spectral channels (expected T.<wavelength>nm channels, e.g. T.550,000000nm)");
+    }
+    for (auto& [name, layer] : layers) {
+      std::sort(layer.channels.begin(), layer.channels.end());
+      for (std::size_t i = 1; i < layer.channels.size(); ++i) {
+        if (layer.channels[i].first == layer.channels[i - 1].first) {
+          throw InputError(p, "channels \"" + layer.channels[i - 1].second + "\" and \"" + layer.channels[i].second +
+                                  "\" have the same wavelength");
+        }
+      }
+    }
+
+    // Attributes.
+    SpectralExrInfo& info = image.info;
+    for (auto it = header.begin(); it != header.end(); ++it) {
+      if (std::string_view(it.name()).rfind("prizma:", 0) == 0) info.is_prizma = true;
+    }
+    if (const auto* s = find_string_attr(header, kAttrLights)) info.lights_json = *s;
+    if (const auto* s = find_string_attr(header, kAttrSampleRange)) info.sample_range = *s;
+    if (const auto* s = find_string_attr(header, kAttrSceneHash)) info.scene_hash = *s;
+    if (const auto* s = find_string_attr(header, kAttrVersion)) info.version = *s;
+    if (const auto* s = find_string_attr(header, kAttrWavelengthSampling)) info.wavelength_sampling = *s;
+    info.samples = int_attr(header, kAttrSamples, p);
+    info.seed = int_attr(header, kAttrSeed, p);
+    nlohmann::json lights_json;
+    if (!info.lights_json.empty()) {
+      lights_json = nlohmann::json::parse(info.lights_json, nullptr, /*allow_exceptions=*/false);
+      if (lights_json.is_discarded()) throw InputError(p, std::string(kAttrLights) + " is not valid JSON");
+    }
+
+    // Light layers: named layers (not variance) if any, else the top-level layer.
+    auto is_variance = [](const std::string& layer) {
+      return layer == kVarianceLayer || (layer.size() > 4 && layer.compare(layer.size() - 4, 4, ".var") == 0);
+    };
+    std::vector<std::string> light_layers;
+    for (const auto& [name, layer] : layers) {
+      if (name.empty() || is_variance(name)) continue;
+      if (!valid_light_name(name)) {
+        throw InputError(p, "layer \"" + name + "\" is not a valid light name (letters, digits, '_' and '-')");
+      }
+      light_layers.push_back(name);
+    }
+    // JSON order of the lights when it names exactly these layers (the file's channels are sorted).
+    std::vector<std::string> json_names;
+    if (lights_json.is_array()) {
+      for (const auto& l : lights_json) {
+        if (l.is_object() && l.contains("name") && l["name"].is_string()) json_names.push_back(l["name"]);
+      }
+    }
+    if (!light_layers.empty()) {
+      std::vector<std::string> sorted_json = json_names;
+      std::sort(sorted_json.begin(), sorted_json.end());
+      if (sorted_json == light_layers) light_layers = json_names;
+    }
+
+    struct Source {
+      std::string name;          // light name
+      std::string layer;         // layer prefix in the file
+      std::string variance;      // variance layer prefix, or empty
+    };
+    std::vector<Source> sources;
+    if (!light_layers.empty()) {
+      for (const auto& l : light_layers) {
+        sources.push_back({l, l, layers.count(l + ".var") ? l + ".var" : std::string()});
+      }
+    } else {
+      if (!layers.count("")) {
+        throw InputError(p, "only variance layers, no spectral T.<wavelength>nm layer");
+      }
+      std::string name = "default";
+      if (json_names.size() == 1 && valid_light_name(json_names.front())) name = json_names.front();
+      sources.push_back({name, "", layers.count(kVarianceLayer) ? std::string(kVarianceLayer) : std::string()});
+    }
+
+    // Every light (and the top level and variance layers) must carry the same wavelengths.
+    const std::vector<double> lambdas = layers.at(sources.front().layer).lambdas();
+    auto check_same = [&](const std::string& layer, const std::string& what) {
+      const auto other = layers.at(layer).lambdas();
+      if (other != lambdas) {
+        throw InputError(p, what + " has " + describe_lambdas(other) + ", but layer \"" + sources.front().layer +
+                                "\" has " + describe_lambdas(lambdas) + ": light layers must share their channels");
+      }
+    };
+    for (const auto& s : sources) {
+      check_same(s.layer, s.layer.empty() ? "the top-level layer" : "layer \"" + s.layer + "\"");
+      if (!s.variance.empty()) check_same(s.variance, "variance layer \"" + s.variance + "\"");
+    }
+    if (!light_layers.empty() && layers.count("")) check_same("", "the top-level layer");
+    const int n = static_cast<int>(lambdas.size());
+
+    // Bin edges: prizma:binEdgesNm (checked against the centres), else midpoints between centres.
+    std::vector<double> edges;
+    if (const auto* a = header.findTypedAttribute<Imf::FloatVectorAttribute>(kAttrEdges)) {
+      const auto& fe = a->value();
+      if (fe.size() != static_cast<std::size_t>(n) + 1) {
+        throw InputError(p, std::string(kAttrEdges) + " has " + std::to_string(fe.size()) + " edges for " +
+                                std::to_string(n) + " spectral channels (expected " + std::to_string(n + 1) + ")");
+      }
+      edges.assign(fe.begin(), fe.end());
+      // The exact decimal copy, used only when it agrees with the float edges.
+      if (const auto* s = find_string_attr(header, kAttrEdgesExact)) {
+        std::vector<double> exact;
+        for (auto tok : detail::split(*s, ' ')) {
+          double v = 0.0;
+          if (!detail::parse_double(tok, v)) break;
+          exact.push_back(v);
+        }
+        bool agree = exact.size() == edges.size();
+        for (std::size_t i = 0; agree && i < exact.size(); ++i) agree = static_cast<float>(exact[i]) == fe[i];
+        if (agree) edges = exact;
+      }
+      for (int i = 0; i < n; ++i) {
+        if (!(lambdas[static_cast<std::size_t>(i)] > edges[static_cast<std::size_t>(i)] &&
+              lambdas[static_cast<std::size_t>(i)] < edges[static_cast<std::size_t>(i) + 1])) {
+          std::ostringstream os;
+          os << "channel " << layers.at(sources.front().layer).channels[static_cast<std::size_t>(i)].second
+             << " (centre " << lambdas[static_cast<std::size_t>(i)] << " nm) is not inside its bin ["
+             << edges[static_cast<std::size_t>(i)] << ", " << edges[static_cast<std::size_t>(i) + 1] << "] nm of "
+             << kAttrEdges;
+          throw InputError(p, os.str());
+        }
+      }
+    } else {
+      if (n < 2) throw InputError(p, "a single spectral channel without prizma:binEdgesNm gives no bin width");
+      edges.resize(static_cast<std::size_t>(n) + 1);
+      for (int i = 1; i < n; ++i) edges[i] = 0.5 * (lambdas[i - 1] + lambdas[i]);
+      edges[0] = lambdas[0] - (edges[1] - lambdas[0]);
+      edges[n] = lambdas[n - 1] + (lambdas[n - 1] - edges[n - 1]);
+    }
+    try {
+      image.bins = BinLayout::from_edges(edges);
+    } catch (const InputError& e) {
+      throw InputError(p, "bin edges: " + e.reason());
+    }
+
+    // Pixels: one slice per channel, straight into each light's buffer.
+    const std::size_t count = image.pixel_count() * static_cast<std::size_t>(n);
+    Imf::FrameBuffer fb;
+    for (const auto& s : sources) {
+      TransportLayer& light = image.lights.emplace_back();
+      light.name = s.name;
+    }
+    for (std::size_t k = 0; k < sources.size(); ++k) {
+      TransportLayer& light = image.lights[k];
+      light.data.assign(count, 0.0f);
+      add_slices(fb, layers.at(sources[k].layer), light.data, dw, n);
+      if (!sources[k].variance.empty()) {
+        light.variance.assign(count, 0.0f);
+        add_slices(fb, layers.at(sources[k].variance), light.variance, dw, n);
+      }
+    }
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+
+    for (std::size_t k = 0; k < sources.size(); ++k) {
+      const std::string what = sources[k].layer.empty() ? "layer T" : "layer \"" + sources[k].layer + "\"";
+      check_finite(image.lights[k].data, image.width, n, what, p);
+      if (!sources[k].variance.empty()) {
+        check_finite(image.lights[k].variance, image.width, n, "layer \"" + sources[k].variance + "\"", p);
+      }
+    }
+    return image;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    // OpenEXR (Iex) exceptions: truncated or corrupt files.
+    throw InputError(p, std::string("cannot read OpenEXR file (truncated or corrupt?): ") + e.what());
+  }
+}
+
+}  // namespace prizma::spectral

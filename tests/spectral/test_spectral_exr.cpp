@@ -1,0 +1,477 @@
+// The spectral EXR layout: round trips, the published single-layer layout written by plain OpenEXR
+// code, and the refusals of read_spectral_exr.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <ImfChannelList.h>
+#include <ImfFloatVectorAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+#include <half.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/spectral_exr.h"
+
+namespace fs = std::filesystem;
+using namespace prizma::spectral;
+
+namespace {
+
+class SpectralExr : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    m_dir = fs::temp_directory_path() / ("prizma-test-exr-" + std::to_string(::getpid()) + "-" + info->name());
+    fs::remove_all(m_dir);
+    fs::create_directories(m_dir);
+  }
+  void TearDown() override { fs::remove_all(m_dir); }
+  fs::path file(const std::string& name) const { return m_dir / name; }
+  fs::path m_dir;
+};
+
+// Random transport in [0, 2), a fixed seed per light.
+TransportLayer make_layer(const std::string& name, int w, int h, int bins, unsigned seed, bool variance) {
+  TransportLayer l;
+  l.name = name;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 2.0f);
+  l.data.resize(static_cast<std::size_t>(w) * h * bins);
+  for (auto& v : l.data) v = u(rng);
+  if (variance) {
+    l.variance.resize(l.data.size());
+    for (auto& v : l.variance) v = 1e-3f * u(rng);
+  }
+  return l;
+}
+
+SpectralImage make_image(int w, int h, const BinLayout& bins, const std::vector<std::string>& names,
+                         bool variance = false) {
+  SpectralImage img;
+  img.width = w;
+  img.height = h;
+  img.bins = bins;
+  unsigned seed = 1;
+  for (const auto& n : names) img.lights.push_back(make_layer(n, w, h, bins.size(), seed++, variance));
+  return img;
+}
+
+std::vector<std::string> channel_names(const fs::path& p) {
+  Imf::InputFile f(p.c_str());
+  std::vector<std::string> out;
+  for (auto it = f.header().channels().begin(); it != f.header().channels().end(); ++it) out.push_back(it.name());
+  return out;
+}
+
+bool has_channel(const fs::path& p, const std::string& name) {
+  Imf::InputFile f(p.c_str());
+  return f.header().channels().findChannel(name) != nullptr;
+}
+
+// Writes a file of the published layout with plain OpenEXR code: one value per channel, constant over
+// the image, channel names given verbatim.
+void write_plain_exr(const fs::path& p, int w, int h, const std::vector<std::string>& names,
+                     const std::vector<float>& values, Imf::PixelType type = Imf::FLOAT) {
+  Imf::Header header(w, h);
+  header.insert("spectralLayoutVersion", Imf::StringAttribute("1.0"));
+  for (const auto& n : names) header.channels().insert(n, Imf::Channel(type));
+  std::vector<std::vector<float>> planes(names.size());
+  std::vector<std::vector<half>> half_planes(names.size());
+  Imf::FrameBuffer fb;
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    planes[c].assign(static_cast<std::size_t>(w) * h, values[c]);
+    half_planes[c].assign(planes[c].size(), half(values[c]));
+    char* base = type == Imf::HALF ? reinterpret_cast<char*>(half_planes[c].data())
+                                   : reinterpret_cast<char*>(planes[c].data());
+    const std::size_t elem = type == Imf::HALF ? sizeof(half) : sizeof(float);
+    fb.insert(names[c], Imf::Slice(type, base, elem, elem * static_cast<std::size_t>(w)));
+  }
+  Imf::OutputFile out(p.c_str(), header);
+  out.setFrameBuffer(fb);
+  out.writePixels(h);
+}
+
+std::string read_error(const fs::path& p) {
+  try {
+    read_spectral_exr(p);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+}  // namespace
+
+TEST(SpectralChannelName, SixDecimalsWithComma) {
+  EXPECT_EQ(spectral_channel_name(550.0), "T.550,000000nm");
+  EXPECT_EQ(spectral_channel_name(392.5), "T.392,500000nm");
+  EXPECT_EQ(spectral_channel_name(412.3456789), "T.412,345679nm");
+  EXPECT_EQ(spectral_channel_name(550.0, "key"), "key.T.550,000000nm");
+  EXPECT_EQ(spectral_channel_name(550.0, "key.var"), "key.var.T.550,000000nm");
+}
+
+TEST_F(SpectralExr, OneLightRoundTripIsBitExact) {
+  SpectralImage img = make_image(7, 5, BinLayout::linear(400, 700, 12), {"sun"});
+  img.info.samples = 256;
+  img.info.seed = 42;
+  img.info.sample_range = "0:256";
+  img.info.scene_hash = "abc123";
+  img.info.version = "test-version";
+  img.info.wavelength_sampling = "spectral-tracking";
+  img.info.lights_json = R"([{"name":"sun","direction":[0,0,1],"angularSizeDeg":0.5,"spectrum":"D65"}])";
+  const fs::path p = file("one.exr");
+  write_spectral_exr(p, img);
+
+  // The file: top-level T channels only, no per-light layer, the layout version attribute.
+  const auto names = channel_names(p);
+  EXPECT_EQ(names.size(), 12u);
+  EXPECT_TRUE(has_channel(p, "T.412,500000nm"));
+  EXPECT_FALSE(has_channel(p, "sun.T.412,500000nm"));
+  {
+    Imf::InputFile f(p.c_str());
+    const auto* v = f.header().findTypedAttribute<Imf::StringAttribute>("spectralLayoutVersion");
+    ASSERT_NE(v, nullptr);
+    EXPECT_EQ(v->value(), "1.0");
+    const auto* e = f.header().findTypedAttribute<Imf::FloatVectorAttribute>("prizma:binEdgesNm");
+    ASSERT_NE(e, nullptr);
+    ASSERT_EQ(e->value().size(), 13u);
+    EXPECT_EQ(e->value().front(), 400.0f);
+    EXPECT_EQ(e->value().back(), 700.0f);
+    EXPECT_EQ(f.header().channels().begin().channel().type, Imf::FLOAT);
+  }
+
+  const SpectralImage back = read_spectral_exr(p);
+  EXPECT_EQ(back.width, 7);
+  EXPECT_EQ(back.height, 5);
+  EXPECT_EQ(back.bins, img.bins);
+  ASSERT_EQ(back.lights.size(), 1u);
+  EXPECT_EQ(back.lights[0].name, "sun");  // from prizma:lights
+  EXPECT_EQ(back.lights[0].data, img.lights[0].data);
+  EXPECT_TRUE(back.lights[0].variance.empty());
+  EXPECT_TRUE(back.info.is_prizma);
+  EXPECT_EQ(back.info.samples, 256);
+  EXPECT_EQ(back.info.seed, 42);
+  EXPECT_EQ(back.info.sample_range, "0:256");
+  EXPECT_EQ(back.info.scene_hash, "abc123");
+  EXPECT_EQ(back.info.version, "test-version");
+  EXPECT_EQ(back.info.wavelength_sampling, "spectral-tracking");
+  EXPECT_EQ(back.info.lights_json, img.info.lights_json);
+}
+
+TEST_F(SpectralExr, ThreeLightsWithVarianceRoundTrip) {
+  SpectralImage img = make_image(6, 4, BinLayout::linear(380, 780, 16), {"key", "fill", "rim_2"}, true);
+  img.lights[1].variance.clear();  // one light without variance
+  img.info.seed = std::int64_t{1} << 40;  // beyond int32: stored as a string attribute
+  const fs::path p = file("three.exr");
+  write_spectral_exr(p, img);
+
+  // Top level (sum) + 3 light layers + 2 variance layers, 16 channels each.
+  EXPECT_EQ(channel_names(p).size(), 6u * 16u);
+  EXPECT_TRUE(has_channel(p, "key.T.392,500000nm"));
+  EXPECT_TRUE(has_channel(p, "key.var.T.392,500000nm"));
+  EXPECT_FALSE(has_channel(p, "fill.var.T.392,500000nm"));
+  EXPECT_TRUE(has_channel(p, "T.392,500000nm"));
+
+  const SpectralImage back = read_spectral_exr(p);
+  ASSERT_EQ(back.lights.size(), 3u);
+  // Order from prizma:lights (the scene's), not the file's alphabetical channel order.
+  EXPECT_EQ(back.lights[0].name, "key");
+  EXPECT_EQ(back.lights[1].name, "fill");
+  EXPECT_EQ(back.lights[2].name, "rim_2");
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(back.lights[k].data, img.lights[k].data) << k;
+    EXPECT_EQ(back.lights[k].variance, img.lights[k].variance) << k;
+  }
+  EXPECT_EQ(back.find_light("rim_2"), 2);
+  EXPECT_EQ(back.find_light("nope"), -1);
+  EXPECT_EQ(back.info.seed, std::int64_t{1} << 40);
+
+  // The top-level layer is the sum of the lights (what a reader of the published layout shows).
+  Imf::InputFile f(p.c_str());
+  std::vector<float> top(6 * 4);
+  Imf::FrameBuffer fb;
+  fb.insert("T.392,500000nm", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(top.data()), sizeof(float), 6 * sizeof(float)));
+  f.setFrameBuffer(fb);
+  f.readPixels(0, 3);
+  for (int px = 0; px < 24; ++px) {
+    const double sum = double(img.lights[0].data[px * 16]) + img.lights[1].data[px * 16] + img.lights[2].data[px * 16];
+    EXPECT_FLOAT_EQ(top[px], static_cast<float>(sum)) << px;
+  }
+}
+
+TEST_F(SpectralExr, VarianceCanBeLeftOut) {
+  SpectralImage img = make_image(3, 3, BinLayout::linear(400, 700, 4), {"a"}, true);
+  const fs::path p = file("novar.exr");
+  ExrWriteOptions opts;
+  opts.write_variance = false;
+  write_spectral_exr(p, img, opts);
+  EXPECT_EQ(channel_names(p).size(), 4u);
+  EXPECT_TRUE(read_spectral_exr(p).lights[0].variance.empty());
+  write_spectral_exr(p, img);
+  EXPECT_TRUE(has_channel(p, "var.T.437,500000nm"));
+  EXPECT_EQ(read_spectral_exr(p).lights[0].variance, img.lights[0].variance);
+}
+
+TEST_F(SpectralExr, NonUniformBinsRoundTripExactly) {
+  const BinLayout bins = BinLayout::exponential(380, 780, 10, 1.7);
+  SpectralImage img = make_image(4, 3, bins, {"a", "b"});
+  const fs::path p = file("exp.exr");
+  write_spectral_exr(p, img);
+  const SpectralImage back = read_spectral_exr(p);
+  EXPECT_EQ(back.bins, bins);  // exact, through prizma:binEdgesNmExact
+  EXPECT_TRUE(has_channel(p, spectral_channel_name(bins.centre_nm(3), "b")));
+  EXPECT_EQ(back.lights[1].data, img.lights[1].data);
+}
+
+TEST_F(SpectralExr, HalfRoundTripWithinHalfPrecision) {
+  SpectralImage img = make_image(5, 5, BinLayout::linear(400, 700, 6), {"a"});
+  const fs::path p = file("half.exr");
+  ExrWriteOptions opts;
+  opts.pixel_type = ExrPixelType::Half;
+  write_spectral_exr(p, img, opts);
+  {
+    Imf::InputFile f(p.c_str());
+    EXPECT_EQ(f.header().channels().begin().channel().type, Imf::HALF);
+  }
+  const SpectralImage back = read_spectral_exr(p);
+  ASSERT_EQ(back.lights[0].data.size(), img.lights[0].data.size());
+  for (std::size_t k = 0; k < img.lights[0].data.size(); ++k) {
+    // half has an 11-bit significand: relative rounding error ≤ 2^-11.
+    EXPECT_NEAR(back.lights[0].data[k], img.lights[0].data[k], img.lights[0].data[k] * (1.0 / 2048) + 1e-7) << k;
+  }
+}
+
+TEST_F(SpectralExr, HalfRefusesValuesBeyondRangeUnlessClamped) {
+  SpectralImage img = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"});
+  img.lights[0].data[5] = 70000.0f;
+  const fs::path p = file("big.exr");
+  ExrWriteOptions opts;
+  opts.pixel_type = ExrPixelType::Half;
+  try {
+    write_spectral_exr(p, img, opts);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("65504"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(p));
+
+  opts.clamp_half = true;
+  ::testing::internal::CaptureStderr();
+  write_spectral_exr(p, img, opts);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("warning"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  const SpectralImage back = read_spectral_exr(p);
+  EXPECT_EQ(back.lights[0].data[5], 65504.0f);
+
+  // Float keeps the value.
+  write_spectral_exr(p, img);
+  EXPECT_EQ(read_spectral_exr(p).lights[0].data[5], 70000.0f);
+}
+
+TEST_F(SpectralExr, WriterRefusesNaNAndBadNames) {
+  SpectralImage img = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a", "b"});
+  const fs::path p = file("bad.exr");
+  img.lights[1].data[4] = std::numeric_limits<float>::quiet_NaN();
+  try {
+    write_spectral_exr(p, img);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("\"b\""), std::string::npos) << e.what();
+  }
+  img.lights[1].data[4] = 0.5f;
+  img.lights[1].name = "bad name";
+  EXPECT_THROW(write_spectral_exr(p, img), InputError);
+  img.lights[1].name = "a";
+  EXPECT_THROW(write_spectral_exr(p, img), InputError);  // duplicate
+  img.lights[1].name = "b";
+  img.lights[1].data.pop_back();
+  EXPECT_THROW(write_spectral_exr(p, img), InputError);  // wrong size
+  EXPECT_FALSE(fs::exists(p));
+}
+
+TEST_F(SpectralExr, WriterKeepsExistingFileOnFailure) {
+  SpectralImage good = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"});
+  const fs::path p = file("keep.exr");
+  write_spectral_exr(p, good);
+  SpectralImage bad = good;
+  bad.lights[0].data[0] = std::numeric_limits<float>::infinity();
+  EXPECT_THROW(write_spectral_exr(p, bad), InputError);
+  EXPECT_EQ(read_spectral_exr(p).lights[0].data, good.lights[0].data);
+  EXPECT_THROW(write_spectral_exr(file("no/such/folder/x.exr"), good), RuntimeError);
+}
+
+TEST_F(SpectralExr, ReadsPublishedSingleLayerLayoutWithMidpointEdges) {
+  // Plain OpenEXR file, no prizma: attributes; wavelengths written in several legal spellings:
+  // 500 nm, 5,5E2 nm = 550 nm, 0,6 µm = 600 nm, 650 nm as frequency c/λ in Hz. Plus an RGB preview
+  // that must be ignored.
+  const double hz650 = 299792458.0 / 650e-9;
+  char hz_name[64];
+  std::snprintf(hz_name, sizeof hz_name, "T.%.12eHz", hz650);
+  std::string hz = hz_name;
+  std::replace(hz.begin() + 2, hz.end(), '.', ',');
+  const std::vector<std::string> names = {"T.500nm", "T.5,5E2nm", "T.0,6um", hz, "R", "G", "B"};
+  const std::vector<float> values = {0.1f, 0.2f, 0.3f, 0.4f, 9.0f, 9.0f, 9.0f};
+  const fs::path p = file("plain.exr");
+  write_plain_exr(p, 3, 2, names, values);
+
+  const SpectralImage img = read_spectral_exr(p);
+  EXPECT_FALSE(img.info.is_prizma);
+  ASSERT_EQ(img.bins.size(), 4);
+  // Centres 500, 550, 600, 650: edges at midpoints, first and last mirrored.
+  const std::vector<double> expected = {475, 525, 575, 625, 675};
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(img.bins.edges_nm()[i], expected[i], 1e-6) << i;
+  ASSERT_EQ(img.lights.size(), 1u);
+  EXPECT_EQ(img.lights[0].name, "default");
+  ASSERT_EQ(img.lights[0].data.size(), 3u * 2u * 4u);
+  for (int px = 0; px < 6; ++px) {
+    for (int i = 0; i < 4; ++i) EXPECT_EQ(img.lights[0].data[px * 4 + i], values[i]) << px << " " << i;
+  }
+}
+
+TEST_F(SpectralExr, ReadsNonUniformPublishedLayoutSortedByWavelength) {
+  // Alphabetical channel order ("T.1000nm" < "T.450nm"... not here, but "T.0,5um" < "T.450nm") differs
+  // from wavelength order; half pixels are converted.
+  const fs::path p = file("sorted.exr");
+  write_plain_exr(p, 2, 2, {"T.450nm", "T.0,5um", "T.400nm", "T.600nm"}, {0.45f, 0.5f, 0.4f, 0.6f}, Imf::HALF);
+  const SpectralImage img = read_spectral_exr(p);
+  ASSERT_EQ(img.bins.size(), 4);
+  const std::vector<double> expected = {375, 425, 475, 550, 650};
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(img.bins.edges_nm()[i], expected[i], 1e-9) << i;
+  EXPECT_NEAR(img.lights[0].data[0], 0.4f, 1e-3);
+  EXPECT_NEAR(img.lights[0].data[1], 0.45f, 1e-3);
+  EXPECT_NEAR(img.lights[0].data[2], 0.5f, 1e-3);
+  EXPECT_NEAR(img.lights[0].data[3], 0.6f, 1e-3);
+}
+
+TEST_F(SpectralExr, RefusesNonExrBytes) {
+  const fs::path p = file("text.exr");
+  std::ofstream(p) << "this is not an image\n";
+  const std::string err = read_error(p);
+  EXPECT_NE(err.find(p.string()), std::string::npos) << err;
+  EXPECT_NE(err.find("not an OpenEXR file"), std::string::npos) << err;
+  EXPECT_NE(read_error(file("missing.exr")).find("does not exist"), std::string::npos);
+}
+
+TEST_F(SpectralExr, RefusesTruncatedFile) {
+  const SpectralImage img = make_image(32, 32, BinLayout::linear(400, 700, 8), {"a", "b"});
+  const fs::path p = file("cut.exr");
+  write_spectral_exr(p, img);
+  const auto size = fs::file_size(p);
+  // Cut in the pixel data, and cut inside the header.
+  for (const auto keep : {size * 2 / 3, std::uintmax_t{40}}) {
+    const fs::path cut = file("cut-" + std::to_string(keep) + ".exr");
+    fs::copy_file(p, cut);
+    fs::resize_file(cut, keep);
+    const std::string err = read_error(cut);
+    EXPECT_NE(err.find(cut.string()), std::string::npos) << err;
+    EXPECT_EQ(err.find("(no InputError)"), std::string::npos) << "kept " << keep << " of " << size;
+  }
+}
+
+TEST_F(SpectralExr, RefusesEmissiveOnly) {
+  const fs::path p = file("emissive.exr");
+  write_plain_exr(p, 2, 2, {"S0.500nm", "S0.600nm"}, {1.0f, 2.0f});
+  const std::string err = read_error(p);
+  EXPECT_NE(err.find(p.string()), std::string::npos) << err;
+  EXPECT_NE(err.find("emissive"), std::string::npos) << err;
+}
+
+TEST_F(SpectralExr, RefusesNoSpectralChannels) {
+  const fs::path p = file("rgb.exr");
+  write_plain_exr(p, 2, 2, {"R", "G", "B"}, {1.0f, 2.0f, 3.0f});
+  const std::string err = read_error(p);
+  EXPECT_NE(err.find("no spectral channels"), std::string::npos) << err;
+}
+
+TEST_F(SpectralExr, RefusesSingleChannelWithoutEdges) {
+  const fs::path p = file("single.exr");
+  write_plain_exr(p, 2, 2, {"T.550nm"}, {1.0f});
+  EXPECT_NE(read_error(p).find("bin width"), std::string::npos);
+}
+
+TEST_F(SpectralExr, RefusesInconsistentEdges) {
+  const SpectralImage img = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"});
+  const fs::path p = file("edges.exr");
+  write_spectral_exr(p, img);
+  auto rewrite_edges = [&](const std::vector<float>& edges) {
+    Imf::InputFile in(p.c_str());
+    Imf::Header h = in.header();
+    h.insert("prizma:binEdgesNm", Imf::FloatVectorAttribute(edges));
+    h.erase("prizma:binEdgesNmExact");
+    std::vector<float> buf(2 * 2 * 3);
+    Imf::FrameBuffer fb;
+    for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+      fb.insert(it.name(), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(buf.data()), 3 * sizeof(float),
+                                      6 * sizeof(float)));
+    }
+    in.setFrameBuffer(fb);
+    in.readPixels(0, 1);
+    const fs::path out = file("edges-rewritten.exr");
+    Imf::OutputFile o(out.c_str(), h);
+    o.setFrameBuffer(fb);
+    o.writePixels(2);
+    return out;
+  };
+  // Wrong count.
+  std::string err = read_error(rewrite_edges({400, 500, 600}));
+  EXPECT_NE(err.find("3 edges for 3 spectral channels"), std::string::npos) << err;
+  // Centre 450 outside its bin [400, 440].
+  err = read_error(rewrite_edges({400, 440, 600, 650}));
+  EXPECT_NE(err.find("not inside its bin"), std::string::npos) << err;
+  // Consistent but different edges are accepted as written.
+  const SpectralImage ok = read_spectral_exr(rewrite_edges({420, 480, 620, 680}));
+  EXPECT_EQ(ok.bins.edges_nm(), (std::vector<double>{420, 480, 620, 680}));
+}
+
+TEST_F(SpectralExr, RefusesLightLayersWithDifferentChannels) {
+  const fs::path p = file("mismatch.exr");
+  write_plain_exr(p, 2, 2, {"a.T.500nm", "a.T.600nm", "b.T.500nm", "b.T.650nm"}, {1, 2, 3, 4});
+  const std::string err = read_error(p);
+  EXPECT_NE(err.find("share their channels"), std::string::npos) << err;
+}
+
+TEST_F(SpectralExr, RefusesNaNNamingTheLayer) {
+  const fs::path p = file("nan.exr");
+  write_plain_exr(p, 2, 2, {"key.T.500nm", "key.T.600nm", "fill.T.500nm", "fill.T.600nm"},
+                  {1, 2, std::numeric_limits<float>::quiet_NaN(), 4});
+  const std::string err = read_error(p);
+  EXPECT_NE(err.find("NaN"), std::string::npos) << err;
+  EXPECT_NE(err.find("fill"), std::string::npos) << err;
+}
+
+TEST_F(SpectralExr, ReadsPlainMultiLayerFileAsLights) {
+  // Layers without prizma:lights come back in the file's (alphabetical) order.
+  const fs::path p = file("layers.exr");
+  write_plain_exr(p, 1, 1, {"key.T.500nm", "key.T.600nm", "fill.T.500nm", "fill.T.600nm"}, {1, 2, 3, 4});
+  const SpectralImage img = read_spectral_exr(p);
+  ASSERT_EQ(img.lights.size(), 2u);
+  EXPECT_EQ(img.lights[0].name, "fill");
+  EXPECT_EQ(img.lights[1].name, "key");
+  EXPECT_EQ(img.lights[1].data, (std::vector<float>{1, 2}));
+}
+
+TEST_F(SpectralExr, RefusesInvalidLightsJson) {
+  SpectralImage img = make_image(1, 1, BinLayout::linear(400, 700, 2), {"a"});
+  img.info.lights_json = "[{not json";
+  const fs::path p = file("json.exr");
+  write_spectral_exr(p, img);
+  EXPECT_NE(read_error(p).find("prizma:lights"), std::string::npos);
+}
