@@ -53,6 +53,14 @@ struct LightCommand {
   int basis = 40;
 };
 
+struct TabulateCommand {
+  std::string spectrum;
+  std::string output;
+  double from_nm = 380.0;
+  double to_nm = 780.0;
+  double step_nm = 1.0;
+};
+
 struct DeltaECommand {
   std::string light = "D65";
   std::vector<double> xyz_a;
@@ -105,9 +113,24 @@ ps::Spectrum scene_albedo(const std::filesystem::path& scene_path, const std::st
   const auto albedo = found->find("albedo");
   const std::string input = scene_path.string() + ": " + where + ".albedo";
   if (albedo == found->end()) throw ps::InputError(input, "missing");
-  if (albedo->is_number()) return ps::Spectrum::constant(albedo->get<double>());
-  if (!albedo->is_string()) throw ps::InputError(input, "expected a spectrum spec string or a number");
-  return ps::parse_spectrum(albedo->get<std::string>(), ps::SpecContext{input, scene_path.parent_path()});
+  // A spec string, a number, or {"spectrum": SPEC, "scale": number} (docs/scene-format.md).
+  const auto parse = [&](const nlohmann::json& j, const std::string& where_in) -> ps::Spectrum {
+    if (j.is_number()) return ps::Spectrum::constant(j.get<double>());
+    if (!j.is_string()) throw ps::InputError(where_in, "expected a spectrum spec string or a number");
+    return ps::parse_spectrum(j.get<std::string>(), ps::SpecContext{where_in, scene_path.parent_path()});
+  };
+  if (albedo->is_object()) {
+    const auto inner = albedo->find("spectrum");
+    if (inner == albedo->end()) throw ps::InputError(input + ".spectrum", "missing");
+    ps::Spectrum s = parse(*inner, input + ".spectrum");
+    const auto scale = albedo->find("scale");
+    if (scale != albedo->end()) {
+      if (!scale->is_number()) throw ps::InputError(input + ".scale", "expected a number");
+      s = s.scaled(scale->get<double>());
+    }
+    return s;
+  }
+  return parse(*albedo, input);
 }
 
 void print_table(const std::vector<ps::NamedLight>& lights, const std::vector<double>& values,
@@ -180,6 +203,17 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
   return ps::kExitOk;
 }
 
+int run_tabulate(const TabulateCommand& cmd) {
+  if (!(cmd.step_nm > 0.0) || !(cmd.from_nm < cmd.to_nm) || (cmd.to_nm - cmd.from_nm) / cmd.step_nm > 1e6)
+    throw ps::InputError("--from/--to/--step", "need from < to and a step > 0 giving at most 1e6 samples");
+  const ps::Spectrum s = parse_option(cmd.spectrum, "--spectrum");
+  std::vector<double> lambda;
+  for (double l = cmd.from_nm; l < cmd.to_nm - 1e-9; l += cmd.step_nm) lambda.push_back(l);
+  lambda.push_back(cmd.to_nm);
+  ps::write_spectrum_csv(cmd.output, s.resampled(lambda), "value");
+  return ps::kExitOk;
+}
+
 int run_delta_e(const DeltaECommand& cmd, const CommonOptions& common) {
   const ps::ColourSetting colour = colour_setting(common);
   const ps::Spectrum light = parse_option(cmd.light, "--light");
@@ -246,10 +280,19 @@ int main(int argc, char** argv) {
   sub_delta->add_option("--xyz-a", delta.xyz_a, "X,Y,Z of the first colour")->required()->expected(3)->delimiter(',');
   sub_delta->add_option("--xyz-b", delta.xyz_b, "X,Y,Z of the second colour")->required()->expected(3)->delimiter(',');
 
+  TabulateCommand tabulate;
+  CLI::App* sub_tabulate = app.add_subcommand("tabulate", "write a spectrum spec as a CSV table (for scripts and plots)");
+  sub_tabulate->add_option("--spectrum", tabulate.spectrum, "spectrum spec")->required();
+  sub_tabulate->add_option("--from", tabulate.from_nm, "first wavelength (nm)")->capture_default_str();
+  sub_tabulate->add_option("--to", tabulate.to_nm, "last wavelength (nm)")->capture_default_str();
+  sub_tabulate->add_option("--step", tabulate.step_nm, "step (nm)")->capture_default_str();
+  sub_tabulate->add_option("-o,--output", tabulate.output, "output CSV")->required();
+
   if (const int code = ps::parse_command_line(app, argc, argv); code >= 0) return code;
   return ps::run_tool(program, [&]() {
     if (*sub_metamer) return run_metamer(metamer, common);
     if (*sub_light) return run_light(light, common);
+    if (*sub_tabulate) return run_tabulate(tabulate);
     return run_delta_e(delta, common);
   });
 }

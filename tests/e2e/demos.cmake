@@ -1,0 +1,50 @@
+# The prizma-metamer CLI (label "e2e") and the demonstration scripts at a tiny size (label "demo";
+# each script checks its own claim and exits non-zero when it fails).
+set(PRIZMA_METAMER_WORK ${PRIZMA_E2E_WORK}/metamer)
+file(MAKE_DIRECTORY ${PRIZMA_METAMER_WORK})
+
+if(TARGET prizma-metamer)
+  add_test(NAME metamer.cli.help COMMAND prizma-metamer --help)
+  set_tests_properties(metamer.cli.help PROPERTIES LABELS e2e PASS_REGULAR_EXPRESSION "metamer.*light.*delta-e")
+
+  # A metamer of ColorChecker foliage under D65 split by F11: exit 0, a CSV, the table.
+  add_test(NAME metamer.cli.metamer
+           COMMAND sh -c "\"$0\" metamer --albedo cc:4 --match-light D65 --split-light F11 -o \"$1\" && test -s \"$1\""
+                   $<TARGET_FILE:prizma-metamer> ${PRIZMA_METAMER_WORK}/metamer.csv)
+  set_tests_properties(metamer.cli.metamer PROPERTIES LABELS e2e
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+
+  add_test(NAME metamer.cli.light_reveal
+           COMMAND sh -c "\"$0\" light --albedo-a cc:7 --albedo-b cc:16 --reveal --primaries LED-B3,gaussian:450:20,gaussian:620:20 -o \"$1\" && test -s \"$1\""
+                   $<TARGET_FILE:prizma-metamer> ${PRIZMA_METAMER_WORK}/reveal.csv)
+  set_tests_properties(metamer.cli.light_reveal PROPERTIES LABELS e2e
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+
+  # Input errors: exit 2, one line naming the input, no output file.
+  foreach(case
+      "bad_albedo|metamer --albedo 1.5 --match-light D65 --split-light A -o OUT|error: albedo: value 1.5"
+      "unknown_light|metamer --albedo 0.5 --match-light D66 --split-light A -o OUT|error: --match-light"
+      "hide_and_reveal|light --albedo-a cc:7 --albedo-b cc:16 --hide --reveal -o OUT|error: --hide/--reveal"
+      "same_albedos|light --albedo-a cc:7 --albedo-b cc:7 --reveal -o OUT|error: albedo-b")
+    string(REPLACE "|" ";" parts "${case}")
+    list(GET parts 0 name)
+    list(GET parts 1 args)
+    list(GET parts 2 pattern)
+    set(out ${PRIZMA_METAMER_WORK}/${name}.csv)
+    string(REPLACE "OUT" "${out}" args "${args}")
+    add_test(NAME metamer.cli.${name}
+             COMMAND sh -c "rm -f \"$1\"; msg=$(\"$0\" ${args} 2>&1 >/dev/null); rc=$?; echo \"$msg\"; test $rc -eq 2 && test ! -e \"$1\" && test $(echo \"$msg\" | wc -l) -eq 1 && echo \"$msg\" | grep -q -- \"$2\""
+                     $<TARGET_FILE:prizma-metamer> ${out} "${pattern}")
+    set_tests_properties(metamer.cli.${name} PROPERTIES LABELS e2e
+                         ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+  endforeach()
+endif()
+
+if(TARGET prizma-metamer AND TARGET prizma-render AND TARGET prizma-relight)
+  get_filename_component(_prizma_scripts ${PRIZMA_E2E_DIR}/../../scripts ABSOLUTE)
+  foreach(demo metamerism-demo scattering-demo reveal-demo)
+    add_test(NAME demo.${demo} COMMAND ${_prizma_scripts}/${demo} ${PRIZMA_E2E_WORK}/${demo} --small)
+    set_tests_properties(demo.${demo} PROPERTIES LABELS demo TIMEOUT 120 ENVIRONMENT
+      "PRIZMA_RENDER=$<TARGET_FILE:prizma-render>;PRIZMA_RELIGHT=$<TARGET_FILE:prizma-relight>;PRIZMA_METAMER=$<TARGET_FILE:prizma-metamer>;PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR};MPLCONFIGDIR=${PRIZMA_E2E_WORK}/${demo}/.mpl")
+  endforeach()
+endif()
