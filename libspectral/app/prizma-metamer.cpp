@@ -51,6 +51,7 @@ struct LightCommand {
   std::vector<std::string> primaries;
   std::string output;
   int basis = 40;
+  double max_power_ratio = 2.0;
 };
 
 struct TabulateCommand {
@@ -167,6 +168,7 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
   ps::LightDesignOptions options;
   options.colour = colour_setting(common);
   options.basis_size = cmd.basis;
+  options.max_power_ratio = cmd.max_power_ratio;
   const auto albedo = [&](const std::string& spec, const std::string& material, const std::string& letter) {
     const std::string spec_option = "--albedo-" + letter;
     const std::string material_option = "--material-" + letter;
@@ -271,6 +273,9 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   sub_light->add_option("--basis", light.basis, "free-form light: number of B-spline basis functions")
       ->capture_default_str()->check(CLI::Range(6, 200));
+  sub_light->add_option("--max-power-ratio", light.max_power_ratio,
+                        "radiant power at most this many times the reference's at equal luminance (0: no limit)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   sub_light->add_option("-o,--output", light.output, "output CSV (nm, relative spectral power)")->required();
 
   DeltaECommand delta;

@@ -58,6 +58,7 @@ LightDesignResult design_light(const Spectrum& albedo_a, const Spectrum& albedo_
   if (options.basis_size < 6 || options.basis_size > 200)
     throw InputError("options", "basis size " + std::to_string(options.basis_size) + " is outside [6, 200]");
   if (!(options.step_nm > 0.0)) throw InputError("options", "step_nm must be > 0");
+  if (!(options.max_power_ratio >= 0.0)) throw InputError("options", "max_power_ratio must be >= 0");
   require_non_negative(albedo_a, "albedo-a");
   require_non_negative(albedo_b, "albedo-b");
   require_non_negative(reference_light, "reference light");
@@ -171,16 +172,31 @@ LightDesignResult design_light(const Spectrum& albedo_a, const Spectrum& albedo_
   // white does not change with the light's scale, so the box only fixes the scale).
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(k);
   const Eigen::VectorXd one = Eigen::VectorXd::Ones(k);
+  // The power limit is the half-space (power − ratio·P_ref/Y_ref·luminance)·w ≤ 0.
+  Eigen::MatrixXd power_row(1, k);
+  for (int j = 0; j < k; ++j) power_row(0, j) = working[static_cast<size_t>(j)].integrate(lo_nm, hi_nm);
+  const double reference_power = reference_light.integrate(lo_nm, hi_nm);
+  const bool limit_power = options.max_power_ratio > 0.0 && reference_power > 0.0;
+  if (limit_power) power_row -= (options.max_power_ratio * reference_power / reference_luminance) * white.row(1);
   const auto project_box = [&](const Eigen::VectorXd& w) -> std::optional<Eigen::VectorXd> {
     Eigen::VectorXd c = w.cwiseMax(zero).cwiseMin(one);
+    if (limit_power && (power_row * c)(0) > 0.0) {
+      const std::optional<Eigen::VectorXd> p = detail::project_box_affine(power_row, Eigen::VectorXd::Zero(1), c, zero, one);
+      if (!p) return std::nullopt;
+      c = *p;
+    }
     if (!(c.maxCoeff() > 0.0)) return std::nullopt;
     return c;
   };
-  detail::AscentResult best{starts.front(), objective(starts.front())};
+  std::optional<detail::AscentResult> found;
   for (const Eigen::VectorXd& s : starts) {
-    const detail::AscentResult r = detail::projected_ascent(objective, project_box, s, options.iterations, 0.25);
-    if (r.value > best.value) best = r;
+    const std::optional<Eigen::VectorXd> start = project_box(s);
+    if (!start) continue;
+    const detail::AscentResult r = detail::projected_ascent(objective, project_box, *start, options.iterations, 0.25);
+    if (!found || r.value > found->value) found = r;
   }
+  if (!found) throw InputError("primaries", "no mix of them satisfies the power limit (max_power_ratio)");
+  detail::AscentResult best = *found;
 
   // Hiding: the light closest to the reference's shape under which both albedos have exactly the same
   // XYZ, when one exists (projection onto {w ≥ 0, (XYZ_a − XYZ_b)·w = 0, Y_white·w = Y_ref}).

@@ -81,14 +81,18 @@ def main():
 
     # 2. Design in the transport domain of the final render's bins.
     lam1, a1 = pd.tabulate(tools, albedo_spec, out / "albedo_left_reference.csv")
-    u1 = np.interp(a1, steps, response[0])
-    pd.write_spectrum_csv(out / "transport_left.csv", lam1, u1, "transport")
+    # Transport divided by the most both spheres can reach, so the design's bounds are [0, 1]; matching
+    # XYZ is linear, so the scale does not change which spectra match.
     u_max = float(min(response[0][-1], response[1][-1]))
-    # The render's bins, in the form the library parses (the scene's own "bins" string).
+    u1 = np.interp(a1, steps, response[0]) / u_max
+    if u1.max() > 1.0:
+        raise pd.DemoFailure("the right sphere cannot reach the left sphere's transport (%.3f > 1)" % u1.max())
+    pd.write_spectrum_csv(out / "transport_left.csv", lam1, u1, "transport")
+    # Designed in the render's bins (the scene's own "bins" string): what the relit image will show.
     design = pd.run([tools.metamer, "--bins", final_bins, "metamer", "--albedo", "csv:%s" % (out / "transport_left.csv"),
-                     "--match-light", MATCH_LIGHT, "--split-light", split_light, "--max", "%.9g" % u_max,
-                     "-o", out / "transport_right.csv"])
+                     "--match-light", MATCH_LIGHT, "--split-light", split_light, "-o", out / "transport_right.csv"])
     lam2, u2 = pd.read_spectrum_csv(out / "transport_right.csv")
+    u2 = u2 * u_max
     grid = np.arange(380.0, 780.0 + 0.5, 1.0)
     u2_fine = np.interp(grid, lam2, u2)
     a2 = np.interp(u2_fine, response[1], steps)  # R_right⁻¹ (monotone)

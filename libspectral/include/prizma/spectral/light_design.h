@@ -17,6 +17,10 @@ struct LightDesignOptions {
   // over the bins' range, tabulated every `step_nm`. At least 6.
   int basis_size = 40;
   double step_nm = 5.0;
+  // Radiant power limit: ∫E dλ over the bins at most this many times the reference light's at the
+  // same luminance (0 = no limit). Without it a revealing light tends to put most of its power where
+  // the eye barely sees (e.g. 700+ nm), which is valid but useless as a lamp.
+  double max_power_ratio = 2.0;
   // Ascent iterations per start.
   int iterations = 150;
 };
