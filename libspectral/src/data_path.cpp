@@ -1,0 +1,47 @@
+#include "prizma/spectral/data_path.h"
+
+#include <cstdlib>
+#include <system_error>
+
+#include "prizma/spectral/error.h"
+
+namespace prizma::spectral {
+
+namespace {
+
+bool is_dir(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::is_directory(p, ec);
+}
+
+}  // namespace
+
+std::filesystem::path data_dir() {
+  // 1. Explicit override.
+  if (const char* env = std::getenv("PRIZMA_DATA_DIR"); env != nullptr && *env != '\0') {
+    return std::filesystem::path(env);
+  }
+  // 2. The source tree's data/ recorded at build time (running from the build tree).
+#ifdef PRIZMA_SOURCE_DATA_DIR
+  {
+    const std::filesystem::path source_dir(PRIZMA_SOURCE_DATA_DIR);
+    if (!source_dir.empty() && is_dir(source_dir)) return source_dir;
+  }
+#endif
+  // 3. Installed layout: <prefix>/bin/<exe> → <prefix>/share/prizma.
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec && !exe.empty()) return exe.parent_path().parent_path() / "share" / "prizma";
+  return std::filesystem::path("share") / "prizma";
+}
+
+std::filesystem::path data_file(const std::filesystem::path& relative) {
+  const auto p = data_dir() / relative;
+  std::error_code ec;
+  if (!std::filesystem::exists(p, ec)) {
+    throw RuntimeError(p.string() + ": data file not found (set PRIZMA_DATA_DIR to Prizma's data folder)");
+  }
+  return p;
+}
+
+}  // namespace prizma::spectral
