@@ -92,7 +92,8 @@ int run(const CliOptions& o) {
   if (!o.preview.empty()) relight::check_output_path(o.preview, "--preview");
 
   relight::RelightSession session(o.input);
-  session.apply(settings_from(o, session));
+  const relight::RelightSettings cli_settings = settings_from(o, session);
+  session.apply(cli_settings);
   if (!o.output.empty()) {
     relight::check_output_options(relight::output_format_for(o.output), session.settings().output);
   }
@@ -113,7 +114,7 @@ int run(const CliOptions& o) {
   if (!o.batch.empty()) {
     const auto outputs = relight::read_batch_file(o.batch, session, session.settings());
     relight::run_batch(session, outputs, o.verbose ? &std::cerr : nullptr);
-    session.apply(settings_from(o, session));
+    session.apply(cli_settings);
   }
   if (!o.output.empty()) {
     const double ms = session.relight();

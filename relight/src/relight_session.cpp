@@ -91,21 +91,18 @@ void RelightSession::apply(RelightSettings settings) {
   if (settings.output.bit_depth != 8 && settings.output.bit_depth != 16) {
     throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(settings.output.bit_depth));
   }
-  spectral::DisplayOptions display_options = settings.output.display;
-  display_options.colour_space.clear();
-  std::unique_ptr<spectral::DisplayTransform> display;
-  const bool display_changed = !m_display || display_options.config != m_display_options.config ||
-                               display_options.display != m_display_options.display ||
-                               display_options.view != m_display_options.view;
-  if (display_changed) display = std::make_unique<spectral::DisplayTransform>(display_options);
   if (!settings.output.display.colour_space.empty()) check_output_options(OutputFormat::Exr, settings.output);
 
+  // The display transform is built when first needed (EXR XYZ output needs no OCIO config).
+  spectral::DisplayOptions display_options = settings.output.display;
+  display_options.colour_space.clear();
+  if (display_options.config != m_display_options.config || display_options.display != m_display_options.display ||
+      display_options.view != m_display_options.view) {
+    m_display.reset();
+  }
   m_settings = std::move(settings);
   m_matrix = std::move(matrix);
-  if (display_changed) {
-    m_display = std::move(display);
-    m_display_options = display_options;
-  }
+  m_display_options = display_options;
   m_dirty = true;
 }
 
@@ -140,6 +137,9 @@ void RelightSession::set_display(const std::string& display) {
   RelightSettings s = m_settings;
   s.output.display.display = display;
   s.output.display.view.clear();
+  spectral::DisplayOptions check = s.output.display;
+  check.colour_space.clear();
+  spectral::DisplayTransform validate(check);  // throws InputError for unknown displays
   apply(std::move(s));
 }
 
@@ -159,7 +159,10 @@ const XyzImage& RelightSession::xyz() {
   return m_xyz;
 }
 
-const spectral::DisplayTransform& RelightSession::display() const { return *m_display; }
+const spectral::DisplayTransform& RelightSession::display() {
+  if (!m_display) m_display = std::make_unique<spectral::DisplayTransform>(m_display_options);
+  return *m_display;
+}
 
 void RelightSession::check_pixel(int x, int y, const std::string& input) const {
   if (x < 0 || y < 0 || x >= m_image.width || y >= m_image.height) {
@@ -232,7 +235,7 @@ ImageMetadata RelightSession::metadata() const {
   if (!m_settings.output.display.colour_space.empty()) {
     md.emplace_back("prizma:colourSpace", m_settings.output.display.colour_space);
   }
-  md.emplace_back("prizma:display", m_display ? m_display->description() : m_settings.output.display.display);
+  md.emplace_back("prizma:display", m_settings.output.display.display);
   return md;
 }
 

@@ -73,8 +73,9 @@ class RelightSession {
   double relight();
   const XyzImage& xyz();
   const RelightMatrix& matrix() const { return m_matrix; }
-  // The display transform for the current settings (built when the display options change).
-  const spectral::DisplayTransform& display() const;
+  // The display transform for the current settings (built on first use after a change; throws
+  // InputError when the config or display does not exist).
+  const spectral::DisplayTransform& display();
 
   ProbeResult probe(int x, int y);
   CompareResult compare(int x1, int y1, int x2, int y2, int radius = 0);

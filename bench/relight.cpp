@@ -1,0 +1,103 @@
+// Relight throughput: XYZ = Σ_l M_l·T_l over a 1024×1024 image with 32 bins and 2 light layers,
+// against a plain streaming read (a sum) of the same transport buffers, interleaved in the same run.
+// Counters: relight_GBps and sum_GBps (transport bytes read per second) and ratio = relight time /
+// sum time (target ≤ 1.5: the relight is memory-bandwidth bound). Arg: threads (0 = all).
+#include <benchmark/benchmark.h>
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_reduce.h>
+
+#include <chrono>
+#include <memory>
+#include <random>
+
+#include "prizma/relight/relight_image.h"
+#include "prizma/relight/relight_matrix.h"
+#include "prizma/spectral/spectral_exr.h"
+
+namespace {
+
+using namespace prizma;
+
+constexpr int kSize = 1024;
+constexpr int kBins = 32;
+
+const spectral::SpectralImage& bench_image() {
+  static const spectral::SpectralImage image = [] {
+    spectral::SpectralImage img;
+    img.width = kSize;
+    img.height = kSize;
+    img.bins = spectral::BinLayout::linear(380.0, 780.0, kBins);
+    std::mt19937 rng(12345);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (const char* name : {"key", "back"}) {
+      spectral::TransportLayer layer;
+      layer.name = name;
+      layer.data.resize(img.pixel_count() * kBins);
+      for (float& v : layer.data) v = u(rng);
+      img.lights.push_back(std::move(layer));
+    }
+    return img;
+  }();
+  return image;
+}
+
+// The baseline: one streaming pass summing every transport value, parallel over rows like the relight.
+double streaming_sum(const spectral::SpectralImage& img) {
+  const std::size_t row = static_cast<std::size_t>(img.width) * kBins;
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, img.height), 0.0,
+      [&](const tbb::blocked_range<int>& rows, double acc) {
+        for (const auto& layer : img.lights) {
+          const float* p = layer.data.data() + static_cast<std::size_t>(rows.begin()) * row;
+          const float* end = layer.data.data() + static_cast<std::size_t>(rows.end()) * row;
+          float s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+          for (; p != end; p += 8)
+            for (int k = 0; k < 8; ++k) s[k] += p[k];
+          for (float v : s) acc += v;
+        }
+        return acc;
+      },
+      [](double a, double b) { return a + b; });
+}
+
+void BM_RelightVsStreamingSum(benchmark::State& state) {
+  std::unique_ptr<tbb::global_control> limit;
+  if (state.range(0) > 0) {
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  static_cast<std::size_t>(state.range(0)));
+  }
+  const spectral::SpectralImage& img = bench_image();
+  std::vector<relight::LightSpec> lights = {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")};
+  const relight::RelightMatrix matrix(img.bins, lights, {});
+  std::vector<float> xyz(3 * img.pixel_count());
+  const double bytes = static_cast<double>(img.lights.size() * img.pixel_count() * kBins * sizeof(float));
+  double relight_s = 0.0, sum_s = 0.0;
+  for (auto _ : state) {
+    // Interleaved so that both see the same machine load.
+    auto t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(streaming_sum(img));
+    auto t1 = std::chrono::steady_clock::now();
+    relight::relight_into(img, matrix, xyz.data());
+    benchmark::ClobberMemory();
+    auto t2 = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(t1 - t0).count();
+    const double r = std::chrono::duration<double>(t2 - t1).count();
+    sum_s += s;
+    relight_s += r;
+    state.SetIterationTime(r);
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["relight_GBps"] = bytes * n / relight_s / 1e9;
+  state.counters["sum_GBps"] = bytes * n / sum_s / 1e9;
+  state.counters["ratio"] = relight_s / sum_s;
+  state.counters["relight_ms"] = 1e3 * relight_s / n;
+  state.counters["sum_ms"] = 1e3 * sum_s / n;
+  state.SetBytesProcessed(static_cast<std::int64_t>(bytes * n));
+}
+
+BENCHMARK(BM_RelightVsStreamingSum)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+}  // namespace
+
+BENCHMARK_MAIN();
