@@ -170,6 +170,11 @@ Spectrum Spectrum::scaled(double factor) const {
   Spectrum s = *this;
   s.m_constant_value *= factor;
   for (double& v : s.m_values) v *= factor;
+  if (!std::isfinite(s.m_constant_value) || !std::all_of(s.m_values.begin(), s.m_values.end(), [](double v) {
+        return std::isfinite(v);
+      })) {
+    throw InputError("spectrum", "scaling by " + format_double(factor) + " overflows");
+  }
   return s;
 }
 
