@@ -6,7 +6,19 @@ function(prizma_set_warnings target)
   endif()
 endfunction()
 
-if(PRIZMA_SANITIZE)
+# PRIZMA_FUZZ: libFuzzer coverage instrumentation for every target (the fuzz targets in tests/fuzz/
+# add -fsanitize=fuzzer for libFuzzer's main). Needs clang; implies the sanitizers below.
+if(PRIZMA_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "PRIZMA_FUZZ needs clang (libFuzzer): configure a fresh build folder with "
+                        "CC=clang CXX=clang++ cmake -S . -B build-fuzz -DPRIZMA_FUZZ=ON")
+  endif()
+  add_compile_options(-fsanitize=fuzzer-no-link)
+endif()
+
+# PRIZMA_SANITIZE: AddressSanitizer + UndefinedBehaviorSanitizer for everything (gcc or clang).
+# UBSan does not recover: the first undefined behaviour aborts the program, so a test fails.
+if(PRIZMA_SANITIZE OR PRIZMA_FUZZ)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
