@@ -1,0 +1,170 @@
+// Display transforms through OpenColorIO 2.1: the config is loaded and the CPU processor built once in
+// the constructor; apply() only runs the processor, which OCIO documents as thread-safe.
+#include "prizma/spectral/display.h"
+
+#include <OpenColorIO/OpenColorIO.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "prizma/spectral/data_path.h"
+#include "prizma/spectral/error.h"
+
+namespace OCIO = OCIO_NAMESPACE;
+
+namespace prizma::spectral {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The input space: OCIO 2.2's interchange role if the config has it, else this name.
+constexpr const char* kXyzRole = "cie_xyz_d65_interchange";
+constexpr const char* kXyzSpace = "CIE-XYZ-D65";
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) {
+    if (!out.empty()) out += ", ";
+    out += n;
+  }
+  return out;
+}
+
+std::vector<std::string> list_displays(const OCIO::ConstConfigRcPtr& config) {
+  std::vector<std::string> out;
+  for (int i = 0; i < config->getNumDisplays(); ++i) out.emplace_back(config->getDisplay(i));
+  return out;
+}
+
+std::vector<std::string> list_views(const OCIO::ConstConfigRcPtr& config, const std::string& display) {
+  std::vector<std::string> out;
+  for (int i = 0; i < config->getNumViews(display.c_str()); ++i) out.emplace_back(config->getView(display.c_str(), i));
+  return out;
+}
+
+std::vector<std::string> list_colour_spaces(const OCIO::ConstConfigRcPtr& config) {
+  std::vector<std::string> out;
+  for (int i = 0; i < config->getNumColorSpaces(); ++i) out.emplace_back(config->getColorSpaceNameByIndex(i));
+  return out;
+}
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  for (const auto& n : names) {
+    if (n == name) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+struct DisplayTransform::Impl {
+  fs::path config_path;
+  OCIO::ConstConfigRcPtr config;
+  OCIO::ConstCPUProcessorRcPtr cpu;
+  std::string description;
+};
+
+fs::path default_ocio_config() {
+  if (const char* env = std::getenv("OCIO"); env != nullptr && env[0] != '\0') return fs::path(env);
+  return data_file("ocio/config.ocio");
+}
+
+DisplayTransform::DisplayTransform(const DisplayOptions& opts) : m_impl(std::make_unique<Impl>()) {
+  Impl& impl = *m_impl;
+  impl.config_path = opts.config.empty() ? default_ocio_config() : opts.config;
+  const std::string cfg = impl.config_path.string();
+
+  // Load and validate the config.
+  std::error_code ec;
+  if (!fs::is_regular_file(impl.config_path, ec)) {
+    throw InputError(cfg, fs::exists(impl.config_path, ec) ? "OCIO config is not a file"
+                                                           : "OCIO config does not exist");
+  }
+  try {
+    impl.config = OCIO::Config::CreateFromFile(cfg.c_str());
+    impl.config->validate();
+  } catch (const OCIO::Exception& e) {
+    throw InputError(cfg, std::string("cannot load OCIO config: ") + e.what());
+  }
+
+  // The XYZ input space.
+  std::string src;
+  if (impl.config->hasRole(kXyzRole)) {
+    src = kXyzRole;
+  } else if (impl.config->getColorSpace(kXyzSpace)) {
+    src = kXyzSpace;
+  } else {
+    throw InputError(cfg, std::string("OCIO config has no \"") + kXyzSpace + "\" colour space and no " + kXyzRole +
+                              " role: Prizma needs CIE XYZ (D65) as input");
+  }
+
+  // The processor: a plain colour space conversion, or a display with its view.
+  OCIO::ConstProcessorRcPtr processor;
+  try {
+    if (!opts.colour_space.empty()) {
+      if (!impl.config->getColorSpace(opts.colour_space.c_str())) {
+        throw InputError("colour space", "unknown colour space \"" + opts.colour_space + "\" in " + cfg +
+                                             " (valid: " + join(list_colour_spaces(impl.config)) + ")");
+      }
+      processor = impl.config->getProcessor(src.c_str(), opts.colour_space.c_str());
+      impl.description = "CIE XYZ (D65) -> colour space \"" + opts.colour_space + "\"";
+    } else {
+      const auto displays = list_displays(impl.config);
+      if (!contains(displays, opts.display)) {
+        throw InputError("display", "unknown display \"" + opts.display + "\" in " + cfg + " (valid: " +
+                                        join(displays) + ")");
+      }
+      std::string view = opts.view;
+      if (view.empty()) {
+        view = impl.config->getDefaultView(opts.display.c_str());
+      } else if (!contains(list_views(impl.config, opts.display), view)) {
+        throw InputError("view", "unknown view \"" + view + "\" of display \"" + opts.display + "\" in " + cfg +
+                                     " (valid: " + join(list_views(impl.config, opts.display)) + ")");
+      }
+      auto t = OCIO::DisplayViewTransform::Create();
+      t->setSrc(src.c_str());
+      t->setDisplay(opts.display.c_str());
+      t->setView(view.c_str());
+      processor = impl.config->getProcessor(t);
+      impl.description = "CIE XYZ (D65) -> display \"" + opts.display + "\", view \"" + view + "\"";
+    }
+    // Lossless optimisation only: no fast pow/exp approximations.
+    impl.cpu = processor->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32,
+                                                   OCIO::OPTIMIZATION_LOSSLESS);
+  } catch (const OCIO::Exception& e) {
+    throw InputError(cfg, std::string("cannot build the OCIO transform: ") + e.what());
+  }
+  impl.description += " (OCIO config " + cfg + ")";
+}
+
+DisplayTransform::~DisplayTransform() = default;
+DisplayTransform::DisplayTransform(DisplayTransform&&) noexcept = default;
+DisplayTransform& DisplayTransform::operator=(DisplayTransform&&) noexcept = default;
+
+void DisplayTransform::apply(float* xyz_interleaved, std::size_t pixel_count) const {
+  if (pixel_count == 0) return;
+  // Chunks keep the per-call image description small; OCIO's CPU processor is stateless per call.
+  constexpr std::size_t kChunk = std::size_t{1} << 20;
+  for (std::size_t start = 0; start < pixel_count; start += kChunk) {
+    const std::size_t n = std::min(kChunk, pixel_count - start);
+    OCIO::PackedImageDesc desc(xyz_interleaved + 3 * start, static_cast<long>(n), 1, 3);
+    try {
+      m_impl->cpu->apply(desc);
+    } catch (const OCIO::Exception& e) {
+      throw RuntimeError(std::string("OCIO transform failed: ") + e.what());
+    }
+  }
+}
+
+const fs::path& DisplayTransform::config_path() const { return m_impl->config_path; }
+
+std::string DisplayTransform::description() const { return m_impl->description; }
+
+std::vector<std::string> DisplayTransform::displays() const { return list_displays(m_impl->config); }
+
+std::vector<std::string> DisplayTransform::colour_spaces() const { return list_colour_spaces(m_impl->config); }
+
+}  // namespace prizma::spectral

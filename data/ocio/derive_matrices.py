@@ -1,0 +1,282 @@
+#!/usr/bin/python3
+"""Derives the matrices of Prizma's OCIO config and writes data/ocio/config.ocio.
+
+Usage: /usr/bin/python3 data/ocio/derive_matrices.py [--check]
+  (no option)  rewrite config.ocio beside this script
+  --check      exit 1 if config.ocio differs from what this script writes
+
+Method (SMPTE RP 177-1993, "Derivation of Basic Television Color Equations"): the normalised primary
+matrix NPM of an RGB space with primaries (xr, yr), (xg, yg), (xb, yb) and white (xw, yw) is
+    P = [[xr/yr, xg/yg, xb/yb], [1, 1, 1], [zr/yr, zg/yg, zb/yb]]   (columns: XYZ of each primary, Y = 1)
+    S = P^-1 · W,  W = XYZ of the white with Y = 1
+    NPM = P · diag(S)                                               (RGB → XYZ)
+Conversions between two spaces with the same white: NPM_dst^-1 · NPM_src. For ACEScg (AP1, ACES
+white) the D65 white is first adapted to the ACES white with the Bradford transform, as the ACES
+documentation does (aces-dev, transforms/ctl/README-MATRIX.md: the Rec.709 → ACES matrices there use
+a Bradford chromatic adaptation); the result is compared with the published values below.
+
+The config's reference space is linear Rec.709/sRGB (D65). XYZ enters through the XYZ → linear sRGB
+matrix of IEC 61966-2-1:1999 §5.2 as printed (4 decimals), the same matrix as libspectral's
+xyz_to_linear_srgb_matrix(), so the config and libspectral agree to float rounding.
+"""
+import pathlib
+import sys
+
+import numpy as np
+
+D65 = (0.3127, 0.3290)           # CIE 015:2018 (4-decimal xy used by sRGB, Rec.709, P3-D65, Rec.2020)
+ACES_WHITE = (0.32168, 0.33767)  # SMPTE ST 2065-1 (≈ D60)
+
+PRIMARIES = {
+    # name: ((xr, yr), (xg, yg), (xb, yb)), white
+    "Rec.709": (((0.640, 0.330), (0.300, 0.600), (0.150, 0.060)), D65),   # ITU-R BT.709-6, IEC 61966-2-1
+    "P3-D65": (((0.680, 0.320), (0.265, 0.690), (0.150, 0.060)), D65),    # SMPTE EG 432-1 (Display P3)
+    "Rec.2020": (((0.708, 0.292), (0.170, 0.797), (0.131, 0.046)), D65),  # ITU-R BT.2020-2
+    "AP1": (((0.713, 0.293), (0.165, 0.830), (0.128, 0.044)), ACES_WHITE),  # SMPTE ST 2065-1 / S-2014-004
+}
+
+# IEC 61966-2-1:1999 §5.2, XYZ → linear sRGB as printed.
+XYZ_TO_SRGB_IEC = np.array([[3.2406, -1.5372, -0.4986],
+                            [-0.9689, 1.8758, 0.0415],
+                            [0.0557, -0.2040, 1.0570]])
+
+# Published linear Rec.709 (D65) → ACEScg with Bradford adaptation, as used by ASWF MaterialX
+# (libraries/stdlib/genglsl/lib/mx_transform_color.glsl) and the ACES OCIO configs; 8 decimals.
+SRGB_TO_ACESCG_PUBLISHED = np.array([[0.61309740, 0.33952315, 0.04737945],
+                                     [0.07019372, 0.91635388, 0.01345240],
+                                     [0.02061559, 0.10956977, 0.86981463]])
+
+BRADFORD = np.array([[0.8951, 0.2664, -0.1614],
+                     [-0.7502, 1.7135, 0.0367],
+                     [0.0389, -0.0685, 1.0296]])
+
+
+def xy_to_xyz(xy):
+    x, y = xy
+    return np.array([x / y, 1.0, (1.0 - x - y) / y])
+
+
+def npm(name):
+    prims, white = PRIMARIES[name]
+    p = np.column_stack([xy_to_xyz(c) for c in prims])
+    s = np.linalg.solve(p, xy_to_xyz(white))
+    return p @ np.diag(s)
+
+
+def bradford(src_white, dst_white):
+    src = BRADFORD @ xy_to_xyz(src_white)
+    dst = BRADFORD @ xy_to_xyz(dst_white)
+    return np.linalg.inv(BRADFORD) @ np.diag(dst / src) @ BRADFORD
+
+
+def rgb_to_rgb(src, dst):
+    m = np.linalg.inv(npm(dst))
+    src_white, dst_white = PRIMARIES[src][1], PRIMARIES[dst][1]
+    if src_white != dst_white:
+        m = m @ bradford(src_white, dst_white)
+    return m @ npm(src)
+
+
+def clean(m):
+    """Rounding noise (|v| < 1e-12, e.g. the exact zeros of P3's blue column) to +0."""
+    return np.where(np.abs(m) < 1e-12, 0.0, m) + 0.0
+
+
+def ocio_matrix(m):
+    """A 3×3 matrix as OCIO's row-major 4×4 list."""
+    m = clean(m)
+    rows = [list(m[0]) + [0.0], list(m[1]) + [0.0], list(m[2]) + [0.0], [0.0, 0.0, 0.0, 1.0]]
+    return "[" + ", ".join(f"{v:.10g}" for r in rows for v in r) + "]"
+
+
+def fmt3(m):
+    m = clean(m)
+    return "\n".join("#     " + "  ".join(f"{v:+.10f}" for v in row) for row in m)
+
+
+def build_config():
+    srgb_to_p3 = rgb_to_rgb("Rec.709", "P3-D65")
+    srgb_to_2020 = rgb_to_rgb("Rec.709", "Rec.2020")
+    srgb_to_ap1 = rgb_to_rgb("Rec.709", "AP1")
+
+    # Sanity checks: white maps to white, the derived sRGB NPM matches IEC's inverse to its 4 decimals,
+    # the ACEScg matrix matches the published one.
+    for name, m in (("P3", srgb_to_p3), ("Rec.2020", srgb_to_2020), ("ACEScg", srgb_to_ap1)):
+        assert np.allclose(m @ np.ones(3), np.ones(3), atol=1e-6), name
+    assert np.allclose(np.linalg.inv(npm("Rec.709")), XYZ_TO_SRGB_IEC, atol=1e-3)
+    assert np.allclose(srgb_to_ap1, SRGB_TO_ACESCG_PUBLISHED, atol=2e-6), srgb_to_ap1 - SRGB_TO_ACESCG_PUBLISHED
+
+    return f"""\
+# Prizma's OpenColorIO config (OCIO v2; loads in OCIO 2.1, which has no built-in ocio:// configs).
+# GENERATED by data/ocio/derive_matrices.py: edit the script, not this file. See README.md here.
+#
+# Reference space: linear Rec.709 / sRGB primaries, D65 white ("Linear sRGB").
+# Input: CIE XYZ, D65-relative (the white of the relighter is Y = 1 at D65), "CIE-XYZ-D65".
+#
+# Matrices (row-major, applied to column vectors), derived from the primaries and white per
+# SMPTE RP 177 (normalised primary matrices):
+#   XYZ -> linear sRGB: IEC 61966-2-1:1999 section 5.2 as printed (4 decimals)
+{fmt3(XYZ_TO_SRGB_IEC)}
+#   linear sRGB -> linear Display P3 (P3-D65 primaries, D65):
+{fmt3(srgb_to_p3)}
+#   linear sRGB -> linear Rec.2020 (ITU-R BT.2020 primaries, D65):
+{fmt3(srgb_to_2020)}
+#   linear sRGB -> ACEScg (AP1 primaries, ACES white 0.32168, 0.33767), with the Bradford-adapted
+#   D65 -> ACES white ("D60") matrix as in the ACES documentation (aces-dev README-MATRIX.md);
+#   agrees with the published 8-decimal matrix within 2e-6:
+{fmt3(srgb_to_ap1)}
+#
+# Transfer functions: "sRGB" and "Display P3" use the IEC 61966-2-1 piecewise curve
+# (ExponentWithLinearTransform gamma 2.4, offset 0.055, inverse = encode); "Rec.2020" uses
+# ITU-R BT.1886 with a zero black level, i.e. a pure 2.4 power (ExponentTransform, inverse = encode).
+
+ocio_profile_version: 2
+
+environment:
+  {{}}
+search_path: ""
+strictparsing: true
+luma: [0.2126, 0.7152, 0.0722]
+name: prizma
+description: Prizma display config (linear sRGB reference, XYZ D65 input)
+
+roles:
+  default: Linear sRGB
+  reference: Linear sRGB
+  scene_linear: Linear sRGB
+  rendering: Linear sRGB
+  compositing_linear: Linear sRGB
+  color_timing: Linear sRGB
+  color_picking: sRGB
+  texture_paint: sRGB
+  matte_paint: sRGB
+  data: Raw
+  aces_interchange: ACEScg
+  cie_xyz_d65_interchange: CIE-XYZ-D65
+
+file_rules:
+  - !<Rule> {{name: Default, colorspace: default}}
+
+displays:
+  sRGB:
+    - !<View> {{name: Standard, colorspace: sRGB}}
+  Display P3:
+    - !<View> {{name: Standard, colorspace: Display P3}}
+  Rec.2020:
+    - !<View> {{name: Standard, colorspace: Rec.2020}}
+
+active_displays: [sRGB, Display P3, Rec.2020]
+active_views: [Standard]
+
+colorspaces:
+  - !<ColorSpace>
+    name: Linear sRGB
+    family: Linear
+    equalitygroup: ""
+    bitdepth: 32f
+    description: Linear Rec.709 / sRGB primaries, D65 white (the reference space)
+    isdata: false
+    allocation: uniform
+
+  - !<ColorSpace>
+    name: CIE-XYZ-D65
+    family: Linear
+    equalitygroup: ""
+    bitdepth: 32f
+    description: CIE 1931 XYZ, D65 white at Y = 1 (Prizma's relighter output)
+    isdata: false
+    allocation: uniform
+    to_scene_reference: !<MatrixTransform> {{matrix: {ocio_matrix(XYZ_TO_SRGB_IEC)}}}
+
+  - !<ColorSpace>
+    name: ACEScg
+    family: Linear
+    equalitygroup: ""
+    bitdepth: 32f
+    description: ACEScg (AP1 primaries, ACES white), Bradford-adapted from D65
+    isdata: false
+    allocation: uniform
+    from_scene_reference: !<MatrixTransform> {{matrix: {ocio_matrix(srgb_to_ap1)}}}
+
+  - !<ColorSpace>
+    name: Linear Display P3
+    family: Linear
+    equalitygroup: ""
+    bitdepth: 32f
+    description: Linear P3-D65 primaries
+    isdata: false
+    allocation: uniform
+    from_scene_reference: !<MatrixTransform> {{matrix: {ocio_matrix(srgb_to_p3)}}}
+
+  - !<ColorSpace>
+    name: Linear Rec.2020
+    family: Linear
+    equalitygroup: ""
+    bitdepth: 32f
+    description: Linear ITU-R BT.2020 primaries, D65
+    isdata: false
+    allocation: uniform
+    from_scene_reference: !<MatrixTransform> {{matrix: {ocio_matrix(srgb_to_2020)}}}
+
+  - !<ColorSpace>
+    name: sRGB
+    family: Display
+    equalitygroup: ""
+    bitdepth: 32f
+    description: sRGB display (IEC 61966-2-1 primaries and piecewise curve)
+    isdata: false
+    allocation: uniform
+    from_scene_reference: !<ExponentWithLinearTransform> {{gamma: 2.4, offset: 0.055, direction: inverse}}
+
+  - !<ColorSpace>
+    name: Display P3
+    family: Display
+    equalitygroup: ""
+    bitdepth: 32f
+    description: Display P3 (P3-D65 primaries, sRGB curve)
+    isdata: false
+    allocation: uniform
+    from_scene_reference: !<GroupTransform>
+      children:
+        - !<MatrixTransform> {{matrix: {ocio_matrix(srgb_to_p3)}}}
+        - !<ExponentWithLinearTransform> {{gamma: 2.4, offset: 0.055, direction: inverse}}
+
+  - !<ColorSpace>
+    name: Rec.2020
+    family: Display
+    equalitygroup: ""
+    bitdepth: 32f
+    description: Rec.2020 display (BT.2020 primaries, BT.1886 pure 2.4 power)
+    isdata: false
+    allocation: uniform
+    from_scene_reference: !<GroupTransform>
+      children:
+        - !<MatrixTransform> {{matrix: {ocio_matrix(srgb_to_2020)}}}
+        - !<ExponentTransform> {{value: 2.4, direction: inverse}}
+
+  - !<ColorSpace>
+    name: Raw
+    family: Utility
+    equalitygroup: ""
+    bitdepth: 32f
+    description: Data, never colour-converted
+    isdata: true
+    allocation: uniform
+"""
+
+
+def main():
+    out = pathlib.Path(__file__).resolve().parent / "config.ocio"
+    text = build_config()
+    if "--check" in sys.argv[1:]:
+        if not out.exists() or out.read_text() != text:
+            print(f"{out} is out of date: run {sys.argv[0]}", file=sys.stderr)
+            return 1
+        return 0
+    out.write_text(text)
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
