@@ -1,5 +1,6 @@
 #include "prizma/render/camera.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <string>
 

@@ -240,15 +240,19 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
         const float xi = rng.uniform() * c;
         if (xi < ma) return;  // absorbed: no emission, the path ends
         if (xi < ma + ms) {
-          const float k = c / (mu * ms);
-          for (int i = 0; i < n; ++i) w[i] *= ss[i] * k;
+          if constexpr (kLanes != 1) {  // one lane: the factor is exactly 1 (analog tracking)
+            const float k = c / (mu * ms);
+            for (int i = 0; i < n; ++i) w[i] *= ss[i] * k;
+          }
           pos = p;
           material = m;
           scattered = true;
           break;
         }
-        const float k = c / (mu * mn);
-        for (int i = 0; i < n; ++i) w[i] *= sn[i] * k;
+        if constexpr (kLanes != 1) {
+          const float k = c / (mu * mn);
+          for (int i = 0; i < n; ++i) w[i] *= sn[i] * k;
+        }
       }
     }
     if (!scattered) {

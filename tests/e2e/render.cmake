@@ -1,0 +1,55 @@
+# End-to-end tests of prizma-render: a tiny scene (tests/e2e/render/tiny.json), shards and merge,
+# and the failure cases (exit codes, one-line errors, no file left behind).
+if(NOT TARGET prizma-render)
+  return()
+endif()
+
+set(_render_work ${PRIZMA_E2E_WORK}/render)
+set(_tiny ${PRIZMA_E2E_DIR}/render/tiny.json)
+
+# prizma_render_e2e(NAME ARGS [key value]...): one run_and_check.cmake invocation.
+function(prizma_render_e2e name args)
+  set(defs -DEXE=$<TARGET_FILE:prizma-render> "-DARGS=${args}" -DWORKDIR=${_render_work})
+  set(extra ${ARGN})
+  set(props "")
+  while(extra)
+    list(POP_FRONT extra key value)
+    if(key STREQUAL "FIXTURES_SETUP" OR key STREQUAL "FIXTURES_REQUIRED")
+      list(APPEND props ${key} ${value})
+    else()
+      list(APPEND defs "-D${key}=${value}")
+    endif()
+  endwhile()
+  add_test(NAME render.e2e.${name}
+           COMMAND ${CMAKE_COMMAND} ${defs} -P ${PRIZMA_E2E_DIR}/render/run_and_check.cmake)
+  set_tests_properties(render.e2e.${name} PROPERTIES ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}"
+                       RESOURCE_LOCK render_e2e_work ${props})
+endfunction()
+
+prizma_render_e2e(help "--help" OUT_REGEX "--spp.*--samples.*--preview")
+prizma_render_e2e(version "--version" OUT_REGEX "prizma-render [0-9]")
+prizma_render_e2e(merge_help "merge|--help" OUT_REGEX "shards")
+prizma_render_e2e(render "${_tiny}|-o|tiny.exr|--preview|tiny.png|--variance|--threads|2"
+  MUST_EXIST "tiny.exr|tiny.png" ERR_REGEX "4 spp \\(0:4\\)")
+prizma_render_e2e(shard0 "${_tiny}|--samples|0:2|-o|shard0.exr|-q" MUST_EXIST shard0.exr FIXTURES_SETUP render_shards)
+prizma_render_e2e(shard1 "${_tiny}|--samples|2:4|-o|shard1.exr|-q" MUST_EXIST shard1.exr FIXTURES_SETUP render_shards)
+prizma_render_e2e(merge "merge|shard0.exr|shard1.exr|-o|merged.exr|--preview|merged.png"
+  MUST_EXIST "merged.exr|merged.png" ERR_REGEX "samples 0:4" FIXTURES_REQUIRED render_shards)
+prizma_render_e2e(merge_overlap "merge|shard0.exr|shard0.exr|-o|overlap.exr" EXPECT_RC 2
+  MUST_NOT_EXIST overlap.exr ERR_REGEX "overlap" ERR_LINES 1 FIXTURES_REQUIRED render_shards)
+prizma_render_e2e(resume "${_tiny}|--resume|shard0.exr|--spp|4|-o|resumed.exr|-q" MUST_EXIST resumed.exr
+  FIXTURES_REQUIRED render_shards)
+
+# Failures: usage errors exit 2 with "prizma-render: error: ..." and write nothing.
+prizma_render_e2e(bad_option "${_tiny}|--bogus|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
+  ERR_REGEX "prizma-render: error:")
+prizma_render_e2e(missing_scene "no_such_scene.json|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
+  ERR_REGEX "prizma-render: error: .*no_such_scene.json" ERR_LINES 1)
+prizma_render_e2e(unwritable "${_tiny}|-o|no_such_folder/out.exr" EXPECT_RC 2
+  MUST_NOT_EXIST no_such_folder/out.exr ERR_REGEX "no_such_folder" ERR_LINES 1)
+prizma_render_e2e(bad_samples "${_tiny}|--samples|5:2|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
+  ERR_REGEX "--samples" ERR_LINES 1)
+prizma_render_e2e(bad_bins "${_tiny}|--bins|linear:700:400:3|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
+  ERR_REGEX "--bins" ERR_LINES 1)
+prizma_render_e2e(bad_sampling "${_tiny}|--wavelength-sampling|hero|-o|bad.exr" EXPECT_RC 2
+  MUST_NOT_EXIST bad.exr)

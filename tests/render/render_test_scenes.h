@@ -1,0 +1,97 @@
+#pragma once
+// Tiny hand-built scenes for the renderer's tests: a box medium seen by an orthographic camera
+// looking down −z, so every pixel's ray crosses the box along z over its full depth.
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "prizma/render/render.h"
+#include "prizma/render/scene.h"
+#include "prizma/spectral/spectrum.h"
+
+namespace prizma::render::testing {
+
+inline Material make_material(spectral::Spectrum albedo, spectral::Spectrum sigma_t, spectral::Spectrum g) {
+  Material m;
+  m.name = "m";
+  m.albedo = std::move(albedo);
+  m.sigma_t_per_unit = std::move(sigma_t);
+  m.anisotropy = std::move(g);
+  return m;
+}
+
+inline Material grey_material(double albedo, double sigma_t, double g = 0.0) {
+  return make_material(spectral::Spectrum::constant(albedo), spectral::Spectrum::constant(sigma_t),
+                       spectral::Spectrum::constant(g));
+}
+
+inline Light environment_light(std::string name = "env") {
+  Light l;
+  l.name = std::move(name);
+  l.direction = Eigen::Vector3d::Zero();
+  l.spectrum_spec = "E";
+  return l;
+}
+
+inline Light directional_light(std::string name, Eigen::Vector3d dir, double angular_size_deg = 0.0) {
+  Light l;
+  l.name = std::move(name);
+  l.direction = dir;
+  l.angular_size_deg = angular_size_deg;
+  l.spectrum_spec = "E";
+  return l;
+}
+
+// A unit box [−0.5, 0.5]³ of n³ voxels, all of material 0 at density 1, one environment light, an
+// orthographic camera of ortho_height 0.8 (every ray crosses the box over depth 1), 8×8 pixels.
+inline Scene box_scene(const Material& material, int n = 4, int pixels = 8, std::int64_t spp = 64) {
+  Scene s;
+  s.medium.dims = {n, n, n};
+  s.medium.material.assign(s.medium.voxel_count(), 0);
+  s.medium.density.assign(s.medium.voxel_count(), 1.0f);
+  s.medium.materials = {material};
+  s.lights = {environment_light()};
+  s.camera.type = CameraType::Orthographic;
+  s.camera.position = {0, 0, 2};
+  s.camera.look_at = {0, 0, 0};
+  s.camera.up = {0, 1, 0};
+  s.camera.ortho_height = 0.8;
+  s.camera.width = pixels;
+  s.camera.height = pixels;
+  s.settings.bins = spectral::BinLayout::linear(400, 700, 6);
+  s.settings.sample_begin = 0;
+  s.settings.sample_end = spp;
+  s.settings.seed = 7;
+  s.settings.write_variance = true;
+  s.hash = "test";
+  return s;
+}
+
+// Fills the density with a fixed pseudo-random field in [lo, hi] (heterogeneous medium).
+inline void randomise_density(Scene& s, float lo, float hi, unsigned seed = 3) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<float> dist(lo, hi);
+  for (float& d : s.medium.density) d = dist(gen);
+}
+
+// Per bin: the mean over all pixels of a layer and its standard error from the variance layer
+// (pixels are independent, so var(mean over P pixels) = Σ var_p / P²).
+struct BinEstimate {
+  std::vector<double> mean, se;
+};
+inline BinEstimate pixel_average(const spectral::SpectralImage& img, int light) {
+  const int nb = img.bins.size();
+  const auto& layer = img.lights[light];
+  BinEstimate e{std::vector<double>(nb, 0.0), std::vector<double>(nb, 0.0)};
+  const double p = static_cast<double>(img.pixel_count());
+  for (std::size_t px = 0; px < img.pixel_count(); ++px)
+    for (int i = 0; i < nb; ++i) {
+      e.mean[i] += layer.data[px * nb + i] / p;
+      if (!layer.variance.empty()) e.se[i] += layer.variance[px * nb + i] / (p * p);
+    }
+  for (double& v : e.se) v = std::sqrt(v);
+  return e;
+}
+
+}  // namespace prizma::render::testing
