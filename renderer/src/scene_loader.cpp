@@ -1,5 +1,6 @@
 // load_scene: the JSON scene file (docs/scene-format.md) → a validated Scene. Every error is an
 // InputError whose input is "<file>: <field path>".
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

@@ -1,6 +1,7 @@
 // NIfTI-1 volumes (.nii, .nii.gz) through libnifti. The header is read and checked first (type,
 // dimensions, memory), then the voxels; every libnifti return is checked.
 #include <nifti1_io.h>
+#include <znzlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -72,7 +73,7 @@ Volume load_nifti_volume(const std::filesystem::path& path) {
   const std::array<int, 3> dims{nim->nx, nim->ny, std::max(nim->nz, 1)};
   const std::size_t count = detail::check_volume_fits(dims, file_bytes, input);
 
-  // Spacing from pixdim (absolute; a collapsed axis of one voxel may carry 0).
+  // Spacing from pixdim (absolute; libnifti already reads a pixdim of 0 as 1).
   std::array<double, 3> spacing{nim->dx, nim->dy, nim->dz};
   for (int a = 0; a < 3; ++a) {
     spacing[a] = std::abs(spacing[a]);
@@ -90,28 +91,44 @@ Volume load_nifti_volume(const std::filesystem::path& path) {
   if (!std::isfinite(slope)) slope = 0.0;
   if (!std::isfinite(inter)) inter = 0.0;
 
-  // Voxels.
-  if (nifti_image_load(nim.get()) != 0 || nim->data == nullptr) {
-    throw InputError(input, "cannot read the voxel data (file corrupt or truncated)");
-  }
   if (static_cast<std::size_t>(nim->nvox) != count || static_cast<std::size_t>(nim->nbyper) != file_bytes) {
     throw InputError(input, "inconsistent header: " + std::to_string(nim->nvox) + " voxels of " +
                                 std::to_string(nim->nbyper) + " bytes");
   }
+
+  // Voxels, read here rather than by nifti_image_load, which zero-fills a short read and succeeds.
+  if (nim->iname == nullptr || nim->iname_offset < 0) throw InputError(input, "header names no voxel data");
+  const std::size_t nbytes = count * file_bytes;
+  std::vector<unsigned char> raw(nbytes);
+  {
+    znzFile fp = znzopen(nim->iname, "rb", nifti_is_gzfile(nim->iname));
+    if (znz_isnull(fp)) throw InputError(input, "cannot open the voxel data " + std::string(nim->iname));
+    const bool seek_ok = znzseek(fp, nim->iname_offset, SEEK_SET) >= 0;
+    const std::size_t got = seek_ok ? znzread(raw.data(), 1, nbytes, fp) : 0;
+    znzclose(fp);
+    if (got != nbytes) {
+      throw InputError(input, "cannot read the voxel data: file corrupt or truncated (needs " + std::to_string(nbytes) +
+                                  " bytes at offset " + std::to_string(nim->iname_offset) + ")");
+    }
+  }
+  if (nim->swapsize > 1 && nim->byteorder != nifti_short_order()) {
+    nifti_swap_Nbytes(count, nim->swapsize, raw.data());
+  }
+  const void* data = raw.data();
   Volume vol;
   vol.dims = dims;
   vol.spacing = spacing;
   vol.source = input;
   vol.values.resize(count);
   switch (dt) {
-    case DT_UINT8: convert<std::uint8_t>(nim->data, count, slope, inter, vol.values); break;
-    case DT_INT8: convert<std::int8_t>(nim->data, count, slope, inter, vol.values); break;
-    case DT_UINT16: convert<std::uint16_t>(nim->data, count, slope, inter, vol.values); break;
-    case DT_INT16: convert<std::int16_t>(nim->data, count, slope, inter, vol.values); break;
-    case DT_UINT32: convert<std::uint32_t>(nim->data, count, slope, inter, vol.values); break;
-    case DT_INT32: convert<std::int32_t>(nim->data, count, slope, inter, vol.values); break;
-    case DT_FLOAT32: convert<float>(nim->data, count, slope, inter, vol.values); break;
-    case DT_FLOAT64: convert<double>(nim->data, count, slope, inter, vol.values); break;
+    case DT_UINT8: convert<std::uint8_t>(data, count, slope, inter, vol.values); break;
+    case DT_INT8: convert<std::int8_t>(data, count, slope, inter, vol.values); break;
+    case DT_UINT16: convert<std::uint16_t>(data, count, slope, inter, vol.values); break;
+    case DT_INT16: convert<std::int16_t>(data, count, slope, inter, vol.values); break;
+    case DT_UINT32: convert<std::uint32_t>(data, count, slope, inter, vol.values); break;
+    case DT_INT32: convert<std::int32_t>(data, count, slope, inter, vol.values); break;
+    case DT_FLOAT32: convert<float>(data, count, slope, inter, vol.values); break;
+    case DT_FLOAT64: convert<double>(data, count, slope, inter, vol.values); break;
     default: break;
   }
   return vol;

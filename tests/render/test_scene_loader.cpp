@@ -1,0 +1,429 @@
+// load_scene: the happy path (every field), relative paths, the hash, and one test per class of
+// input error, each checking the field path ("<file>: <field path>") and the reason.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+#include "prizma/render/scene.h"
+#include "prizma/spectral/error.h"
+#include "test_scene_util.h"
+
+namespace prizma::render {
+namespace {
+
+using nlohmann::json;
+using spectral::InputError;
+using testing::ScratchDir;
+
+json base_scene() {
+  return json::parse(R"({
+    "description": "test scene",
+    "volume": {"type": "procedural", "name": "cube_sphere", "resolution": 16},
+    "materials": [
+      {"name": "cube", "range": [50, 150], "albedo": 0.99, "extinction": {"spectrum": "1", "scale": 3},
+       "anisotropy": 0},
+      {"name": "sphere", "range": [200, 255], "albedo": "cc:dark-skin", "extinction": 5,
+       "density": [[200, 0.5], [255, 1]]}
+    ],
+    "camera": {"type": "perspective", "position": [0, 0, 3], "look_at": [0, 0, 0], "up": [0, 1, 0],
+               "fov_deg": 40, "width": 32, "height": 24},
+    "lights": [{"name": "side", "direction": [2, 0, 0], "spectrum": "D65", "angular_size_deg": 1},
+               {"name": "sky", "direction": [0, 0, 0]}],
+    "bins": "linear:400:700:12",
+    "samples": 8,
+    "seed": 7,
+    "max_bounces": 5,
+    "wavelength_sampling": "single",
+    "output": "out/x.exr"
+  })");
+}
+
+std::filesystem::path write_scene(const ScratchDir& dir, const json& j, const std::string& name = "scene.json") {
+  return dir.write(name, j.dump(2));
+}
+
+// Loads and expects an InputError with input "<file>: <field>" and a reason containing `reason`.
+void expect_error(const ScratchDir& dir, const json& j, const std::string& field, const std::string& reason) {
+  const auto path = write_scene(dir, j);
+  try {
+    load_scene(path);
+    FAIL() << "no error; expected " << field << ": " << reason;
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.input(), path.string() + (field.empty() ? "" : ": " + field)) << e.what();
+    EXPECT_NE(e.reason().find(reason), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneLoader, HappyPathFillsEveryField) {
+  ScratchDir dir;
+  const auto path = write_scene(dir, base_scene());
+  const Scene s = load_scene(path);
+  EXPECT_EQ(s.source, path);
+  EXPECT_EQ(s.output, dir.path() / "out/x.exr");
+  EXPECT_EQ(s.hash.size(), 16u);
+  // Medium: 16³ cube_sphere, two materials.
+  EXPECT_EQ(s.medium.dims, (std::array<int, 3>{16, 16, 16}));
+  ASSERT_EQ(s.medium.materials.size(), 2u);
+  EXPECT_EQ(s.medium.materials[0].name, "cube");
+  EXPECT_DOUBLE_EQ(s.medium.materials[0].sigma_t_per_unit.eval(550.0), 3.0);
+  EXPECT_DOUBLE_EQ(s.medium.materials[0].albedo.eval(550.0), 0.99);
+  EXPECT_DOUBLE_EQ(s.medium.materials[1].sigma_t_per_unit.eval(550.0), 5.0);
+  EXPECT_GT(s.medium.materials[1].albedo.eval(600.0), 0.0);
+  EXPECT_LT(s.medium.materials[1].albedo.eval(600.0), 1.0);
+  EXPECT_TRUE(s.medium.bounds_max.isApprox(Eigen::Vector3d(0.5, 0.5, 0.5)));
+  // Voxels: centre = sphere (value 255 → density 1), corner empty, cube region = material 0.
+  auto idx = [](int x, int y, int z) { return (static_cast<std::size_t>(z) * 16 + y) * 16 + x; };
+  EXPECT_EQ(s.medium.material[idx(8, 8, 8)], 1);
+  EXPECT_FLOAT_EQ(s.medium.density[idx(8, 8, 8)], 1.0f);
+  EXPECT_EQ(s.medium.material[idx(0, 0, 0)], Medium::kEmpty);
+  EXPECT_EQ(s.medium.material[idx(2, 8, 8)], 0);
+  // Camera, lights, settings.
+  EXPECT_EQ(s.camera.type, CameraType::Perspective);
+  EXPECT_EQ(s.camera.width, 32);
+  EXPECT_EQ(s.camera.height, 24);
+  EXPECT_DOUBLE_EQ(s.camera.fov_y_deg, 40.0);
+  EXPECT_TRUE(s.camera.position.isApprox(Eigen::Vector3d(0, 0, 3)));
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].name, "side");
+  EXPECT_TRUE(s.lights[0].direction.isApprox(Eigen::Vector3d(1, 0, 0)));  // normalised
+  EXPECT_DOUBLE_EQ(s.lights[0].angular_size_deg, 1.0);
+  EXPECT_EQ(s.lights[1].direction, Eigen::Vector3d::Zero());
+  EXPECT_EQ(s.lights[1].spectrum_spec, "D65");
+  EXPECT_EQ(s.settings.bins, spectral::BinLayout::linear(400, 700, 12));
+  EXPECT_EQ(s.settings.sample_begin, 0);
+  EXPECT_EQ(s.settings.sample_end, 8);
+  EXPECT_EQ(s.settings.seed, 7u);
+  EXPECT_EQ(s.settings.max_bounces, 5);
+  EXPECT_EQ(s.settings.wavelength_sampling, WavelengthSampling::Single);
+}
+
+TEST(SceneLoader, DefaultsWhenOptionalFieldsAreMissing) {
+  ScratchDir dir;
+  json j = base_scene();
+  for (const char* k : {"camera", "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "output", "description"}) {
+    j.erase(k);
+  }
+  const Scene s = load_scene(write_scene(dir, j, "minimal.json"));
+  EXPECT_EQ(s.output, dir.path() / "minimal.exr");
+  EXPECT_EQ(s.camera.width, 256);
+  EXPECT_EQ(s.settings.sample_end, 64);
+  EXPECT_EQ(s.settings.seed, 1u);
+  EXPECT_EQ(s.settings.max_bounces, -1);
+  EXPECT_EQ(s.settings.wavelength_sampling, WavelengthSampling::SpectralTracking);
+  EXPECT_EQ(s.settings.bins, spectral::BinLayout());
+}
+
+TEST(SceneLoader, NormalisedRangesAndOrthographicCamera) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["normalisation"] = {{"min", 0}, {"max", 255}};
+  j["materials"][1]["units"] = "normalised";
+  j["materials"][1]["range"] = {0.7, 1.0};                 // raw ≥ 178.5: the sphere
+  j["materials"][1]["density"] = {{0.0, 2.0}, {1.0, 2.0}};  // constant 2
+  j["camera"] = {{"type", "orthographic"}, {"ortho_height", 2.5}, {"width", 8}, {"height", 8}};
+  const Scene s = load_scene(write_scene(dir, j));
+  auto idx = [](int x, int y, int z) { return (static_cast<std::size_t>(z) * 16 + y) * 16 + x; };
+  EXPECT_EQ(s.medium.material[idx(8, 8, 8)], 1);
+  EXPECT_FLOAT_EQ(s.medium.density[idx(8, 8, 8)], 2.0f);
+  EXPECT_EQ(s.camera.type, CameraType::Orthographic);
+  EXPECT_DOUBLE_EQ(s.camera.ortho_height, 2.5);
+}
+
+TEST(SceneLoader, RawVolumeAndCsvPathsAreRelativeToTheSceneFile) {
+  ScratchDir dir;
+  std::filesystem::create_directories(dir / "sub/data");
+  // 2×2×2 uint16 big-endian: values 0..7 (value 7 at the last voxel).
+  std::string bytes;
+  for (int i = 0; i < 8; ++i) bytes += {static_cast<char>(0), static_cast<char>(i)};
+  dir.write("sub/data/v_2x2x2_uint16.raw", bytes);
+  dir.write("sub/data/ext.csv", "nm,value\n400,1\n700,2\n");
+  json j = base_scene();
+  j["volume"] = {{"type", "raw"}, {"path", "data/v_2x2x2_uint16.raw"}, {"endianness", "big"}, {"spacing", {1, 1, 2}}};
+  j["materials"] = json::array({{{"name", "m"}, {"range", {4, 7}}, {"albedo", 0.5}, {"extinction", "csv:data/ext.csv"}}});
+  j["lights"][0]["spectrum"] = "csv:data/ext.csv*2";
+  const Scene s = load_scene(write_scene(dir, j, "sub/scene.json"));
+  EXPECT_EQ(s.medium.material[3], Medium::kEmpty);
+  EXPECT_EQ(s.medium.material[4], 0);
+  EXPECT_EQ(s.medium.material[7], 0);
+  EXPECT_DOUBLE_EQ(s.medium.materials[0].sigma_t_per_unit.eval(550.0), 1.5);
+  EXPECT_TRUE(s.medium.bounds_max.isApprox(Eigen::Vector3d(0.25, 0.25, 0.5)));
+  // The light's csv path is made absolute so the spec works from any folder.
+  EXPECT_EQ(s.lights[0].spectrum_spec, "csv:" + (dir / "sub/data/ext.csv").string() + "*2");
+  EXPECT_EQ(s.output, dir / "sub/out/x.exr");
+}
+
+TEST(SceneLoader, TransferFunctionImage) {
+  ScratchDir dir;
+  // 2 wide, 2 high: row 0 empty, row 1 a material with albedo 1, extinction 0.2·scale, g = 0.
+  const std::vector<unsigned char> px{0, 0, 0, 0, 0, 0, 255, 51, 255, 255, 51, 255};
+  auto out = OIIO::ImageOutput::create((dir / "tf.png").string());
+  ASSERT_TRUE(out);
+  ASSERT_TRUE(out->open((dir / "tf.png").string(), OIIO::ImageSpec(2, 2, 3, OIIO::TypeDesc::UINT8)));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
+  ASSERT_TRUE(out->close());
+  json j = base_scene();
+  j.erase("materials");
+  j["transfer_function"] = {{"image", "tf.png"}, {"extinction_scale", 50}, {"wavelength_range_nm", {400, 700}}};
+  const Scene s = load_scene(write_scene(dir, j));
+  ASSERT_EQ(s.medium.materials.size(), 1u);
+  EXPECT_NEAR(s.medium.materials[0].sigma_t_per_unit.eval(500.0), 10.0, 1e-5);
+  EXPECT_NEAR(s.medium.materials[0].anisotropy.eval(500.0), 0.999, 1e-9);
+  // auto normalisation over 0..255: values ≥ 127.5 are row 1 (the sphere and nothing else).
+  auto idx = [](int x, int y, int z) { return (static_cast<std::size_t>(z) * 16 + y) * 16 + x; };
+  EXPECT_EQ(s.medium.material[idx(8, 8, 8)], 0);
+  EXPECT_EQ(s.medium.material[idx(2, 8, 8)], Medium::kEmpty);
+}
+
+TEST(SceneLoader, HashIsStableAndFollowsTheText) {
+  ScratchDir dir;
+  json j = base_scene();
+  const std::string h1 = load_scene(write_scene(dir, j)).hash;
+  EXPECT_EQ(load_scene(write_scene(dir, j)).hash, h1);
+  j["seed"] = 8;
+  EXPECT_NE(load_scene(write_scene(dir, j)).hash, h1);
+}
+
+TEST(SceneLoaderErrors, MalformedJsonReportsLineAndColumn) {
+  ScratchDir dir;
+  const auto path = dir.write("bad.json", "{\n  \"samples\": 4,\n  \"seed\" 3\n}\n");
+  try {
+    load_scene(path);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.input(), path.string());
+    EXPECT_NE(e.reason().find("line 3, column"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneLoaderErrors, MissingFile) {
+  ScratchDir dir;
+  EXPECT_THROW(load_scene(dir / "absent.json"), InputError);
+}
+
+TEST(SceneLoaderErrors, UnknownFields) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["sampels"] = 4;
+  expect_error(dir, j, "sampels", "unknown field");
+  j = base_scene();
+  j["materials"][1]["albdo"] = 0.5;
+  expect_error(dir, j, "materials[1].albdo", "unknown field");
+  j = base_scene();
+  j["camera"]["fov"] = 30;
+  expect_error(dir, j, "camera.fov", "unknown field");
+  j = base_scene();
+  j["volume"]["dims"] = {16, 16, 16};  // raw-only field on a procedural volume
+  expect_error(dir, j, "volume.dims", "unknown field");
+}
+
+TEST(SceneLoaderErrors, DuplicateKeys) {
+  ScratchDir dir;
+  const auto path = dir.write("dup.json", R"({"samples": 4, "samples": 5})");
+  try {
+    load_scene(path);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(e.reason().find("duplicate key \"samples\""), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneLoaderErrors, WrongTypes) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["samples"] = "8";
+  expect_error(dir, j, "samples", "must be an integer");
+  j = base_scene();
+  j["samples"] = 2.5;
+  expect_error(dir, j, "samples", "must be an integer");
+  j = base_scene();
+  j["camera"]["position"] = {0, 0};
+  expect_error(dir, j, "camera.position", "array of 3 numbers");
+  j = base_scene();
+  j["lights"][0]["direction"][1] = "up";
+  expect_error(dir, j, "lights[0].direction[1]", "must be a number");
+  j = base_scene();
+  j["materials"][0]["albedo"] = json::array({0.5});
+  expect_error(dir, j, "materials[0].albedo", "spectrum spec");
+  j = base_scene();
+  j["materials"] = json::object();
+  expect_error(dir, j, "materials", "must be an array");
+}
+
+TEST(SceneLoaderErrors, OutOfRangeMaterialValues) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["materials"][0]["extinction"]["scale"] = -3;
+  expect_error(dir, j, "materials[0].extinction.scale", "must be > 0 (got -3)");
+  j = base_scene();
+  j["materials"][1]["albedo"] = 1.5;
+  expect_error(dir, j, "materials[1].albedo", "[0, 1]");
+  j = base_scene();
+  j["materials"][1]["albedo"] = {{"spectrum", "cc:19"}, {"scale", 3}};  // patch 19 (white) ≈ 0.9 → 2.7
+  expect_error(dir, j, "materials[1].albedo", "[0, 1]");
+  j = base_scene();
+  j["materials"][0]["extinction"] = -1;
+  expect_error(dir, j, "materials[0].extinction", "≥ 0");
+  j = base_scene();
+  j["materials"][0]["anisotropy"] = 1.0;
+  expect_error(dir, j, "materials[0].anisotropy", "(-1, 1)");
+  j = base_scene();
+  j["materials"][0]["range"] = {150, 50};
+  expect_error(dir, j, "materials[0].range", "lo must be ≤ hi");
+  j = base_scene();
+  j["materials"][1]["density"] = {{200, 1}, {100, 2}};
+  expect_error(dir, j, "materials[1].density[1][0]", "strictly increasing");
+  j = base_scene();
+  j["materials"][1]["density"] = {{200, -1}};
+  expect_error(dir, j, "materials[1].density[0][1]", "≥ 0");
+  j = base_scene();
+  j["materials"][1]["name"] = "cube";
+  expect_error(dir, j, "materials[1].name", "duplicate material name");
+  j = base_scene();
+  j["materials"] = json::array();
+  expect_error(dir, j, "materials", "at least one");
+}
+
+TEST(SceneLoaderErrors, BadSpectrumSpecsNameTheField) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["materials"][1]["albedo"] = "cc:no-such-patch";
+  const auto path = write_scene(dir, j);
+  try {
+    load_scene(path);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string() + ": materials[1].albedo"), std::string::npos) << e.what();
+  }
+  j = base_scene();
+  j["lights"][1]["spectrum"] = "D66";
+  const auto path2 = write_scene(dir, j);
+  try {
+    load_scene(path2);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path2.string() + ": lights[1].spectrum"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneLoaderErrors, Lights) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["lights"][1]["name"] = "side";
+  expect_error(dir, j, "lights[1].name", "duplicate light name");
+  j = base_scene();
+  j["lights"][0]["name"] = "key light";
+  expect_error(dir, j, "lights[0].name", "letters, digits");
+  j = base_scene();
+  j["lights"][0]["name"] = "";
+  expect_error(dir, j, "lights[0].name", "1 to 64");
+  j = base_scene();
+  j["lights"] = json::array();
+  expect_error(dir, j, "lights", "at least one light");
+  j = base_scene();
+  j.erase("lights");
+  expect_error(dir, j, "lights", "is required");
+  j = base_scene();
+  j["lights"][0]["angular_size_deg"] = 180;
+  expect_error(dir, j, "lights[0].angular_size_deg", "[0, 180)");
+  j = base_scene();
+  j["lights"][0].erase("direction");
+  expect_error(dir, j, "lights[0].direction", "is required");
+}
+
+TEST(SceneLoaderErrors, CameraAndSettings) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["camera"]["width"] = 0;
+  expect_error(dir, j, "camera.width", "must be in [1, 16384] (got 0)");
+  j = base_scene();
+  j["camera"]["fov_deg"] = 180;
+  expect_error(dir, j, "camera.fov_deg", "(0, 180)");
+  j = base_scene();
+  j["camera"]["look_at"] = {0, 0, 3};
+  expect_error(dir, j, "camera.look_at", "must differ from position");
+  j = base_scene();
+  j["camera"]["up"] = {0, 0, -1};
+  expect_error(dir, j, "camera.up", "parallel");
+  j = base_scene();
+  j["camera"]["type"] = "fisheye";
+  expect_error(dir, j, "camera.type", "perspective");
+  j = base_scene();
+  j["samples"] = 0;
+  expect_error(dir, j, "samples", "must be in [1,");
+  j = base_scene();
+  j["seed"] = -1;
+  expect_error(dir, j, "seed", "≥ 0");
+  j = base_scene();
+  j["max_bounces"] = -2;
+  expect_error(dir, j, "max_bounces", "[-1,");
+  j = base_scene();
+  j["wavelength_sampling"] = "hero";
+  expect_error(dir, j, "wavelength_sampling", "spectral-tracking");
+  j = base_scene();
+  j["output"] = "";
+  expect_error(dir, j, "output", "must not be empty");
+  j = base_scene();
+  j["bins"] = "linear:700:400:12";
+  const auto path = write_scene(dir, j);
+  try {
+    load_scene(path);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string() + ": bins"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneLoaderErrors, VolumeAndTransferFunction) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["volume"]["type"] = "vdb";
+  expect_error(dir, j, "volume.type", "\"raw\", \"nifti\" or \"procedural\"");
+  j = base_scene();
+  j["volume"]["name"] = "teapot";
+  expect_error(dir, j, "volume.name", "unknown procedural volume");
+  j = base_scene();
+  j["volume"]["resolution"] = 1;
+  expect_error(dir, j, "volume.resolution", "must be in [2, 2048]");
+  j = base_scene();
+  j["volume"]["spacing"] = {1, 0, 1};
+  expect_error(dir, j, "volume.spacing[1]", "must be > 0");
+  j = base_scene();
+  j["volume"] = {{"type", "raw"}, {"path", "v_2x2x2_uint8.raw"}, {"voxel_type", "uint12"}};
+  expect_error(dir, j, "volume.voxel_type", "unknown voxel type");
+  j = base_scene();
+  j["volume"] = {{"type", "raw"}, {"path", "v_2x2x2_uint8.raw"}, {"endianness", "middle"}};
+  expect_error(dir, j, "volume.endianness", "\"little\" or \"big\"");
+  j = base_scene();
+  j.erase("volume");
+  expect_error(dir, j, "volume", "is required");
+  j = base_scene();
+  j["transfer_function"] = {{"image", "tf.png"}, {"extinction_scale", 1}};
+  expect_error(dir, j, "transfer_function", "not both");
+  j = base_scene();
+  j.erase("materials");
+  expect_error(dir, j, "materials", "is required");
+  j.erase("materials");
+  j["transfer_function"] = {{"image", "tf.png"}, {"extinction_scale", -5}};
+  expect_error(dir, j, "transfer_function.extinction_scale", "must be > 0 (got -5)");
+  j["transfer_function"] = {{"image", "absent.png"}, {"extinction_scale", 5}};
+  expect_error(dir, j, "transfer_function.image", "cannot read image");
+  j = base_scene();
+  j["normalisation"] = {{"min", 5}, {"max", 5}};
+  expect_error(dir, j, "normalisation.max", "must be > min");
+  // A missing raw file names the file itself.
+  j = base_scene();
+  j["volume"] = {{"type", "raw"}, {"path", "absent_2x2x2_uint8.raw"}};
+  const auto path = write_scene(dir, j);
+  try {
+    load_scene(path);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.input(), (dir / "absent_2x2x2_uint8.raw").string());
+  }
+}
+
+}  // namespace
+}  // namespace prizma::render
