@@ -65,8 +65,9 @@ std::string vec3(const Eigen::Vector3d& v) {
 // After a change: relight, report the time, rewrite the preview and show the thumbnail.
 void refresh(RelightSession& session, std::ostream& out, const InteractiveOptions& opts) {
   const double ms = session.relight();
-  out << "relit in " << std::fixed << std::setprecision(2) << ms << " ms\n";
-  out.unsetf(std::ios::floatfield);
+  std::ostringstream line;
+  line << "relit in " << std::fixed << std::setprecision(2) << ms << " ms\n";
+  out << line.str();
   if (!opts.preview.empty()) session.save(opts.preview);
   if (opts.show) {
     const XyzImage& img = session.xyz();
@@ -139,9 +140,9 @@ int run_interactive(RelightSession& session, std::istream& in, std::ostream& out
         const int r = w.size() == 6 ? to_int(w[5], "compare R") : 0;
         const CompareResult c = session.compare(to_int(w[1], "compare X1"), to_int(w[2], "compare Y1"),
                                                 to_int(w[3], "compare X2"), to_int(w[4], "compare Y2"), r);
-        out << "compare\n  Lab1 " << vec3(c.lab1) << "\n  Lab2 " << vec3(c.lab2) << "\n  dE2000 " << std::fixed
-            << std::setprecision(6) << c.delta_e2000 << "\n";
-        out.unsetf(std::ios::floatfield);
+        std::ostringstream de;
+        de << std::fixed << std::setprecision(6) << c.delta_e2000;
+        out << "compare\n  Lab1 " << vec3(c.lab1) << "\n  Lab2 " << vec3(c.lab2) << "\n  dE2000 " << de.str() << "\n";
       } else {
         throw InputError(cmd, "unknown command (try 'help')");
       }

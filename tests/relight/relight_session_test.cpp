@@ -157,6 +157,8 @@ TEST(InteractiveShell, ScriptedSessionThroughAStream) {
   double y = 0.0;
   for (int i = 0; i < 12; ++i) y += e.light(1)(1, i) * i / 11.0;
   EXPECT_NEAR(ys[0], y, 1e-5);
+  // Bins print at full float precision (back's ramp: 1/11 = 0.0909091).
+  EXPECT_NE(text.find("bins back: 0 0.0909091 0.181818"), std::string::npos) << text;
   EXPECT_NE(text.find("dE2000"), std::string::npos);
   EXPECT_NE(text.find("relit in"), std::string::npos);
   // Saved file and preview both hold the final image.
