@@ -79,8 +79,9 @@ TEST(MajorantGrid, DiagonalTraversalIsContiguousAndConsistent) {
     // The segment's midpoint lies in the reported cell.
     // (A ray through an edge or corner gives a zero-length segment in between: no midpoint test.)
     const Eigen::Vector3d p = ray.origin + 0.5 * (seg.t0 + seg.t1) * dir;
-    if (seg.t1 - seg.t0 > 1e-9)
+    if (seg.t1 - seg.t0 > 1e-9) {
       for (int a = 0; a < 3; ++a) EXPECT_EQ(static_cast<int>(std::floor((p[a] + 0.5) / 0.125)), seg.cell[a]);
+    }
     // Consecutive cells share a face.
     if (count > 0) {
       int diff = 0;

@@ -59,7 +59,9 @@ TEST(TracerPhase, SampledCosinesFollowHg) {
                              std::abs(f - hg_cdf(std::nextafter(cf, -2.0f), g))});
     }
     EXPECT_LT(d, 1.95 / std::sqrt(n) + resolution) << "g " << g;
-    if (std::abs(g) < 0.95) EXPECT_LT(resolution, 1e-3) << "g " << g;
+    if (std::abs(g) < 0.95) {
+      EXPECT_LT(resolution, 1e-3) << "g " << g;
+    }
   }
 }
 
