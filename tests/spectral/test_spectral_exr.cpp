@@ -475,3 +475,29 @@ TEST_F(SpectralExr, RefusesInvalidLightsJson) {
   write_spectral_exr(p, img);
   EXPECT_NE(read_error(p).find("prizma:lights"), std::string::npos);
 }
+
+TEST_F(SpectralExr, ReadsDataWindowNotAtOrigin) {
+  // Data window (10, 20)–(12, 21): 3×2 pixels; values encode (x, y, channel).
+  const fs::path p = file("window.exr");
+  const Imath::Box2i dw({10, 20}, {12, 21});
+  Imf::Header header(Imath::Box2i({0, 0}, {31, 31}), dw);
+  const std::vector<std::string> names = {"T.500nm", "T.600nm"};
+  std::vector<float> px(3 * 2 * 2);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x)
+      for (int c = 0; c < 2; ++c) px[(y * 3 + x) * 2 + c] = static_cast<float>(100 * y + 10 * x + c);
+  Imf::FrameBuffer fb;
+  for (int c = 0; c < 2; ++c) {
+    header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+    fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, px.data() + c, dw, 2 * sizeof(float), 6 * sizeof(float)));
+  }
+  {
+    Imf::OutputFile out(p.c_str(), header);
+    out.setFrameBuffer(fb);
+    out.writePixels(2);
+  }
+  const SpectralImage img = read_spectral_exr(p);
+  EXPECT_EQ(img.width, 3);
+  EXPECT_EQ(img.height, 2);
+  EXPECT_EQ(img.lights[0].data, px);
+}
