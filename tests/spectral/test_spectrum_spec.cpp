@@ -2,12 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <thread>
 #include <unistd.h>
 
+#include "prizma/spectral/data_path.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
 
@@ -269,4 +271,27 @@ TEST_F(SpecFiles, WriteThenReadRoundTrips) {
   int files = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(m_dir)) ++files;
   EXPECT_EQ(files, 1);
+}
+
+TEST(DataPath, EnvironmentOverrideAndMissingFiles) {
+  // ctest sets PRIZMA_DATA_DIR to the source tree's data/ folder; data_dir() must follow it.
+  const char* old = std::getenv("PRIZMA_DATA_DIR");
+  const std::string saved = old ? old : "";
+  ::setenv("PRIZMA_DATA_DIR", "/nonexistent/prizma-data", 1);
+  EXPECT_EQ(data_dir(), fs::path("/nonexistent/prizma-data"));
+  EXPECT_THROW((void)data_file("spectra/cie1931_xyz2deg_1nm.csv"), RuntimeError);
+  ::setenv("PRIZMA_DATA_DIR", PRIZMA_TEST_DATA_DIR, 1);
+  EXPECT_TRUE(fs::exists(data_file("spectra/cie1931_xyz2deg_1nm.csv")));
+  try {
+    (void)data_file("spectra/no-such-table.csv");
+    FAIL() << "expected RuntimeError";
+  } catch (const RuntimeError& e) {
+    EXPECT_NE(std::string(e.what()).find("no-such-table.csv"), std::string::npos) << e.what();
+  }
+  // Unset: falls back to the build-time source data folder, which exists in the build tree.
+  ::unsetenv("PRIZMA_DATA_DIR");
+  EXPECT_TRUE(fs::exists(data_dir() / "spectra" / "illuminant_D65_5nm.csv")) << data_dir();
+  if (old) {
+    ::setenv("PRIZMA_DATA_DIR", saved.c_str(), 1);
+  }
 }
