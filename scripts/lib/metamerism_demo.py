@@ -48,7 +48,7 @@ def material_indices(scene):
 
 
 def main():
-    args = pd.parse_args("metamerism-demo", __doc__.splitlines()[0], 192, 64, 24, 16)
+    args = pd.parse_args("metamerism-demo", __doc__.splitlines()[0], 192, 64, 48, 16)
     out = args.out
     tools = pd.Tools()
     split_light = "F11"
@@ -69,8 +69,17 @@ def main():
         cal["materials"][i]["albedo"] = "csv:calibration_albedo.csv"
     pd.write_scene(cal, out / "calibration.json")
     pd.render(tools, out / "calibration.json", out / "calibration.exr", args.size, args.spp, args.seed)
-    t_cal, _ = pd.spectral_layer(out / "calibration.exr")
-    masks = pd.side_masks(t_cal.sum(axis=2))
+    t_cal, _ = pd.combined_transport(out / "calibration.exr", base)
+    # The spheres' regions: pixels where the first bin (albedo 0: no scattering, only the background
+    # seen through the medium) is nearly dark, i.e. the sphere is opaque along the whole pixel.
+    background = t_cal[:, :, 0]
+    opaque = background < 0.02 * max(background.max(), 1e-12)
+    half = opaque.shape[1] // 2
+    masks = [opaque.copy(), opaque.copy()]
+    masks[0][:, half:] = False
+    masks[1][:, :half] = False
+    if masks[0].sum() == 0 or masks[1].sum() == 0:
+        raise pd.DemoFailure("no opaque sphere pixels found (%d, %d)" % (masks[0].sum(), masks[1].sum()))
     np.save(out / "masks.npy", np.stack(masks))
     response = [pd.region_mean(t_cal, m) for m in masks]  # R_side at the albedo values `steps`
     for r in response:
@@ -113,7 +122,7 @@ def main():
     measured = {}
     for light in REPORT_LIGHTS + ([split_light] if split_light not in REPORT_LIGHTS else []):
         exr = out / ("relit_%s.exr" % light)
-        pd.run([tools.relight, out / "metamers.exr", "--light", light, "-o", exr], quiet=True)
+        pd.run([tools.relight, out / "metamers.exr"] + pd.relight_args(base, light) + ["-o", exr], quiet=True)
         xyz = pd.xyz_image(exr)
         xyz_l, xyz_r = (pd.region_mean(xyz, m) for m in masks)
         de = pd.delta_e(tools, light, bins, xyz_l, xyz_r)
@@ -121,7 +130,8 @@ def main():
         role = "match" if light == MATCH_LIGHT else ("split" if light == split_light else "")
         rows.append([light, role, "%.2f" % de])
     for light in (MATCH_LIGHT, split_light):
-        pd.run([tools.relight, out / "metamers.exr", "--light", light, "-o", out / ("relit_%s.png" % light)], quiet=True)
+        pd.run([tools.relight, out / "metamers.exr"] + pd.relight_args(base, light) + ["-o", out / ("relit_%s.png" % light)],
+               quiet=True)
 
     # Figures: the two relit images, the spectra.
     pd.figure_of_images([(out / ("relit_%s.png" % MATCH_LIGHT), "%s: ΔE00 = %.2f" % (MATCH_LIGHT, measured[MATCH_LIGHT])),

@@ -254,3 +254,49 @@ def staircase(edges, values):
         lam += [lo + 1e-3, hi - 1e-3]
         val += [v, v]
     return lam, val
+
+
+def light_scales(scene):
+    """[(name, scale)] of the scene's lights: the factor of their default spectrum ("D65*0.3" → 0.3),
+    so relit images keep the scene's balance between lights."""
+    out = []
+    for l in scene.get("lights", []):
+        spec = l.get("spectrum", "D65")
+        scale = 1.0
+        if isinstance(spec, dict):
+            scale = float(spec.get("scale", 1.0))
+            spec = spec.get("spectrum", "D65")
+        if isinstance(spec, str) and "*" in spec:
+            try:
+                scale *= float(spec.rsplit("*", 1)[1])
+            except ValueError:
+                pass
+        out.append((l["name"], scale))
+    return out
+
+
+def relight_args(scene, spec, only=None):
+    """--light arguments giving every light (or only the lights in `only`, the others off) the spectrum
+    `spec` times the light's own scale."""
+    args = []
+    for name, scale in light_scales(scene):
+        if only is not None and name not in only:
+            value = "off"
+        else:
+            value = spec if scale == 1.0 else "%s*%.9g" % (spec, scale)
+        args += ["--light", "%s=%s" % (name, value)]
+    return args
+
+
+def combined_transport(exr, scene):
+    """Σ_l scale_l · T_l: the transport that relight_args(scene, …) multiplies by the light, and the
+    bin edges."""
+    lights = light_scales(scene)
+    if len(lights) < 2:
+        t, edges = spectral_layer(exr)
+        return t * (lights[0][1] if lights else 1.0), edges
+    total, edges = None, None
+    for name, scale in lights:
+        t, edges = spectral_layer(exr, name)
+        total = scale * t if total is None else total + scale * t
+    return total, edges

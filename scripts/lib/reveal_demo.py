@@ -59,7 +59,7 @@ def main():
         m["albedo"] = "box:380:480" if i == ia else ("box:620:780" if i == ib else 0.0)
     pd.write_scene(label, out / "mri_labels.json")
     pd.render(tools, out / "mri_labels.json", out / "labels.exr", args.size, max(4, args.spp // 2), args.seed)
-    t_label, edges = pd.spectral_layer(out / "labels.exr")
+    t_label, edges = pd.combined_transport(out / "labels.exr", base)
     centres = 0.5 * (np.array(edges[:-1]) + np.array(edges[1:]))
     blue = t_label[:, :, centres < 480].sum(axis=2)
     red = t_label[:, :, centres > 620].sum(axis=2)
@@ -78,7 +78,7 @@ def main():
     final["materials"][ib]["albedo"] = "csv:albedo_b.csv"
     pd.write_scene(final, out / "mri_metamers.json")
     pd.render(tools, out / "mri_metamers.json", out / "mri.exr", args.size, args.spp, args.seed)
-    t, edges = pd.spectral_layer(out / "mri.exr")
+    t, edges = pd.combined_transport(out / "mri.exr", base)
     bins = pd.bins_spec(edges)
     for name, mask in (("a", mask_a), ("b", mask_b)):
         lam, val = pd.staircase(edges, pd.region_mean(t, mask))
@@ -92,8 +92,9 @@ def main():
     lights = {"D65": "D65", "hide": "csv:%s" % (out / "light_hide.csv"), "reveal": "csv:%s" % (out / "light_reveal.csv")}
     measured, rows = {}, []
     for key, spec in lights.items():
-        pd.run([tools.relight, out / "mri.exr", "--light", spec, "-o", out / ("relit_%s.exr" % key)], quiet=True)
-        pd.run([tools.relight, out / "mri.exr", "--light", spec, "-o", out / ("relit_%s.png" % key)], quiet=True)
+        for ext in ("exr", "png"):
+            pd.run([tools.relight, out / "mri.exr"] + pd.relight_args(base, spec) + ["-o", out / ("relit_%s.%s" % (key, ext))],
+                   quiet=True)
         xyz = pd.xyz_image(out / ("relit_%s.exr" % key))
         de = pd.delta_e(tools, spec, bins, pd.region_mean(xyz, mask_a), pd.region_mean(xyz, mask_b))
         measured[key] = de

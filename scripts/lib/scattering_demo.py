@@ -34,8 +34,9 @@ def main():
         raise pd.DemoFailure("nothing visible under the side light")
     np.save(out / "mask.npy", mask)
     rows, ratio = [], {}
-    for lit, lights in (("side", ["side=" + LIGHT, "back=off"]), ("back", ["side=off", "back=" + LIGHT])):
-        light_args = sum((["--light", l] for l in lights), [])
+    scene_json = json.loads(scene.read_text())
+    for lit in ("side", "back"):
+        light_args = pd.relight_args(scene_json, LIGHT, only={lit})
         pd.run([tools.relight, out / "cube_sphere.exr"] + light_args + ["-o", out / ("%s_only.png" % lit)], quiet=True)
         pd.run([tools.relight, out / "cube_sphere.exr"] + light_args +
                ["--colour-space", "Linear sRGB", "-o", out / ("%s_only.exr" % lit)], quiet=True)
