@@ -1,0 +1,257 @@
+#pragma once
+// Shared pieces of the accuracy benchmarks (bench_error_vs_time, bench_bin_study): the benchmark
+// scenes, a reference-render cache, and the error metrics (relative RMSE of the transport, CIEDE2000
+// of a relit image).
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "prizma/relight/light_spec.h"
+#include "prizma/relight/relight_image.h"
+#include "prizma/relight/relight_matrix.h"
+#include "prizma/render/render.h"
+#include "prizma/render/scene.h"
+#include "prizma/render/transfer_function.h"
+#include "prizma/render/volume.h"
+#include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/colour.h"
+#include "prizma/spectral/colour_matching.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/spectral_exr.h"
+#include "prizma/spectral/spectrum_spec.h"
+
+namespace prizma::bench {
+
+namespace fs = std::filesystem;
+
+// The repository's data/ folder (compile definition from bench/CMakeLists.txt).
+inline fs::path source_data_dir() { return fs::path(PRIZMA_BENCH_DATA_DIR); }
+
+// Bin average of a spectrum over [lo, hi] as a constant spectrum: the "grey" version of a material.
+inline spectral::Spectrum grey_of(const spectral::Spectrum& s, double lo_nm, double hi_nm) {
+  if (s.is_constant()) return s;
+  return spectral::Spectrum::constant(s.integrate(lo_nm, hi_nm) / (hi_nm - lo_nm));
+}
+
+// The scene with every material's spectra replaced by their averages over the bins: the same geometry
+// and mean optical thickness, wavelength-independent (the renderer traces it once for all bins).
+inline render::Scene make_grey(render::Scene scene) {
+  const double lo = scene.settings.bins.min_nm(), hi = scene.settings.bins.max_nm();
+  for (auto& m : scene.medium.materials) {
+    m.albedo = grey_of(m.albedo, lo, hi);
+    m.sigma_t_per_unit = grey_of(m.sigma_t_per_unit, lo, hi);
+    m.anisotropy = grey_of(m.anisotropy, lo, hi);
+  }
+  scene.hash += "-grey";
+  return scene;
+}
+
+// Fallback chromatic cube when data/scenes/cube_sphere.json is missing: VPT's sphere_in_cube volume,
+// a thin bluish-scattering cube around a dense reddish sphere, one key light and the environment.
+inline render::Scene builtin_cube_sphere(int resolution) {
+  render::Volume vol = render::make_procedural_volume("cube_sphere", resolution);
+  render::TransferFunction tf;
+  render::Material cube;
+  cube.name = "cube";
+  cube.albedo = spectral::Spectrum({380, 480, 580, 780}, {0.95, 0.9, 0.6, 0.3});
+  cube.sigma_t_per_unit = spectral::Spectrum({380, 500, 600, 780}, {8.0, 4.0, 2.0, 1.0});
+  cube.anisotropy = spectral::Spectrum::constant(0.3);
+  render::Material sphere;
+  sphere.name = "sphere";
+  sphere.albedo = spectral::Spectrum({380, 550, 600, 780}, {0.2, 0.3, 0.9, 0.95});
+  sphere.sigma_t_per_unit = spectral::Spectrum({380, 550, 780}, {40.0, 20.0, 10.0});
+  sphere.anisotropy = spectral::Spectrum::constant(0.0);
+  tf.materials = {cube, sphere};
+  render::MaterialRule r1;
+  r1.value_lo = 50;
+  r1.value_hi = 150;
+  r1.material = 0;
+  render::MaterialRule r2;
+  r2.value_lo = 200;
+  r2.value_hi = 300;
+  r2.material = 1;
+  tf.rules = {r1, r2};
+  render::Scene scene;
+  scene.medium = render::build_medium(vol, tf, "builtin cube_sphere");
+  render::Light key;
+  key.name = "key";
+  key.direction = Eigen::Vector3d(1, 1, 1);
+  render::Light env;
+  env.name = "env";
+  scene.lights = {key, env};
+  scene.hash = "builtin-cube-sphere-" + std::to_string(resolution);
+  return scene;
+}
+
+// A benchmark scene by name: "grey" (the cube with grey materials), "cube", "metamers", "mri".
+// Scene files come from data/scenes/; returns false (and says why) when a file is missing or fails.
+inline bool load_bench_scene(const std::string& name, render::Scene& out, std::string& why) {
+  const fs::path dir = source_data_dir() / "scenes";
+  auto from_file = [&](const std::string& file) {
+    const fs::path p = dir / file;
+    if (!fs::exists(p)) {
+      why = p.string() + " not found";
+      return false;
+    }
+    try {
+      out = render::load_scene(p);
+    } catch (const std::exception& e) {
+      why = e.what();
+      return false;
+    }
+    return true;
+  };
+  if (name == "cube" || name == "grey") {
+    if (!from_file("cube_sphere.json")) {
+      std::cerr << "note: " << why << "; using the built-in chromatic cube\n";
+      out = builtin_cube_sphere(128);
+    }
+    if (name == "grey") out = make_grey(out);
+    return true;
+  }
+  if (name == "metamers") return from_file("metamers.json");
+  if (name == "mri") return from_file("mri.json");
+  why = "unknown scene \"" + name + "\" (known: grey, cube, metamers, mri)";
+  return false;
+}
+
+// Writes a text file atomically, creating its folder.
+inline void write_text(const fs::path& path, const std::string& text) {
+  if (path.has_parent_path()) fs::create_directories(path.parent_path());
+  spectral::write_atomically(path, [&](const fs::path& tmp) {
+    std::ofstream f(tmp, std::ios::binary);
+    f << text;
+    f.close();
+    if (!f) throw spectral::RuntimeError("cannot write " + tmp.string());
+  });
+}
+
+// FNV-1a of a string, hex: cache keys.
+inline std::string hash_hex(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  std::ostringstream o;
+  o << std::hex << h;
+  return o.str();
+}
+
+// Renders (or reads from the cache folder) an image keyed on the scene hash and every setting that
+// changes the result.
+inline spectral::SpectralImage cached_render(const render::Scene& scene, const fs::path& cache_dir,
+                                             const std::string& tag, double* seconds = nullptr) {
+  const auto& st = scene.settings;
+  std::ostringstream key;
+  key << scene.hash << '|' << scene.camera.width << 'x' << scene.camera.height << '|' << st.bins.to_string() << '|'
+      << st.sample_begin << ':' << st.sample_end << '|' << st.seed << '|'
+      << render::wavelength_sampling_name(st.wavelength_sampling) << '|' << st.fold_light_spectra << '|'
+      << st.write_variance << '|' << st.max_bounces;
+  for (const auto& l : scene.lights) key << '|' << l.name << ':' << l.spectrum_spec;
+  const fs::path file = cache_dir / (tag + "-" + hash_hex(key.str()) + ".exr");
+  if (fs::exists(file)) {
+    try {
+      if (seconds) *seconds = 0.0;
+      return spectral::read_spectral_exr(file);
+    } catch (const std::exception& e) {
+      std::cerr << "note: cache file " << file << " unreadable (" << e.what() << "), rendering again\n";
+    }
+  }
+  render::RenderStats stats;
+  spectral::SpectralImage img = render::render(scene, {}, &stats);
+  if (seconds) *seconds = stats.wall_seconds;
+  fs::create_directories(cache_dir);
+  spectral::write_spectral_exr(file, img);
+  return img;
+}
+
+// Relative RMSE of the transport over every pixel, light and bin: sqrt(Σ(x − r)² / Σ r²). With
+// `ref_variance_sum` > 0 (Σ of the reference's variance of the mean), the reference's own noise is
+// subtracted from the numerator (E[(x − r)²] = (x − E r)² + Var r).
+inline double relative_rmse(const spectral::SpectralImage& x, const spectral::SpectralImage& ref,
+                            double* corrected = nullptr) {
+  double num = 0.0, den = 0.0, var = 0.0;
+  for (std::size_t l = 0; l < ref.lights.size(); ++l) {
+    const auto& a = x.lights[l].data;
+    const auto& r = ref.lights[l].data;
+    const auto& rv = ref.lights[l].variance;
+    for (std::size_t k = 0; k < r.size(); ++k) {
+      const double d = static_cast<double>(a[k]) - r[k];
+      num += d * d;
+      den += static_cast<double>(r[k]) * r[k];
+      if (!rv.empty()) var += rv[k];
+    }
+  }
+  if (corrected) *corrected = std::sqrt(std::max(0.0, num - var) / den);
+  return std::sqrt(num / den);
+}
+
+// Relights every layer of `img` with the same light spec (relative to white).
+inline relight::XyzImage relight_all(const spectral::SpectralImage& img, const std::string& light,
+                                     Eigen::Vector3d* white = nullptr) {
+  std::vector<relight::LightSpec> specs;
+  for (std::size_t l = 0; l < img.lights.size(); ++l) specs.push_back(relight::parse_light_spec(light));
+  const relight::RelightMatrix m(img.bins, specs, relight::RelightOptions{});
+  if (white) *white = m.mix_white_xyz();
+  return relight::relight_image(img, m);
+}
+
+struct DeltaEStats {
+  double mean = 0.0;
+  double max = 0.0;
+  double p95 = 0.0;
+};
+
+// CIEDE2000 between two XYZ images, per pixel, in CIELAB relative to `white`.
+inline DeltaEStats delta_e_stats(const relight::XyzImage& a, const relight::XyzImage& b,
+                                 const Eigen::Vector3d& white) {
+  std::vector<double> de(a.pixel_count());
+  for (std::size_t p = 0; p < a.pixel_count(); ++p) {
+    const Eigen::Vector3d xa(a.xyz[3 * p], a.xyz[3 * p + 1], a.xyz[3 * p + 2]);
+    const Eigen::Vector3d xb(b.xyz[3 * p], b.xyz[3 * p + 1], b.xyz[3 * p + 2]);
+    de[p] = spectral::delta_e2000(spectral::xyz_to_lab(xa, white), spectral::xyz_to_lab(xb, white));
+  }
+  DeltaEStats s;
+  for (double v : de) {
+    s.mean += v;
+    s.max = std::max(s.max, v);
+  }
+  s.mean /= static_cast<double>(de.size());
+  std::sort(de.begin(), de.end());
+  s.p95 = de[std::min(de.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(de.size())))];
+  return s;
+}
+
+// Folded-light images store bin averages of T·E: XYZ = k Σ_i T̄E_i ∫_{bin i} cmf dλ with
+// k = 1/∫_{bins} E ȳ dλ (the same white normalisation as the relighter).
+inline relight::XyzImage folded_to_xyz(const spectral::SpectralImage& img, const std::string& light) {
+  const relight::LightSpec ls = relight::parse_light_spec(light);
+  const auto& cmf = spectral::ColorMatching::get(spectral::Observer::Cie1931_2deg);
+  const int nb = img.bins.size();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> w(3, nb);
+  for (int i = 0; i < nb; ++i)
+    for (int c = 0; c < 3; ++c) w(c, i) = cmf.channel(c).integrate(img.bins.lo_nm(i), img.bins.hi_nm(i));
+  const double k = 1.0 / ls.spectrum.integrate_product(cmf.y(), img.bins.min_nm(), img.bins.max_nm());
+  relight::XyzImage out;
+  out.width = img.width;
+  out.height = img.height;
+  out.xyz.assign(3 * img.pixel_count(), 0.0f);
+  for (std::size_t p = 0; p < img.pixel_count(); ++p) {
+    Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+    for (const auto& layer : img.lights)
+      for (int i = 0; i < nb; ++i) xyz += w.col(i) * static_cast<double>(layer.data[p * nb + i]);
+    xyz *= k * ls.scale;
+    for (int c = 0; c < 3; ++c) out.xyz[3 * p + c] = static_cast<float>(xyz[c]);
+  }
+  return out;
+}
+
+}  // namespace prizma::bench
