@@ -60,7 +60,8 @@ class Reader {
 
   void expect_object(const json& j, const std::string& path, std::initializer_list<const char*> known) const {
     if (!j.is_object()) fail(path, "must be an object (got " + describe(j) + ")");
-    for (const auto& [key, value] : j.items()) {
+    for (const auto& item : j.items()) {
+      const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture those
       if (std::none_of(known.begin(), known.end(), [&](const char* k) { return key == k; })) {
         std::string list;
         for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
