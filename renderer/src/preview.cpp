@@ -16,14 +16,21 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
                    const std::vector<Light>& lights, const PreviewOptions& opts) {
   const int nb = image.bins.size();
   const auto& cmf = spectral::ColorMatching::get(spectral::Observer::Cie1931_2deg);
-  // Per light: 3×n weights of its default spectrum, relative to white (exact bin integrals).
+  // Per light: 3×n weights of its default spectrum (exact bin integrals), in units where D65 at
+  // scale 1 gives a perfect white Y = 1, so spec scales ("D65*0.2") keep their relative strength.
+  const double y_d65 =
+      spectral::relight_weights(cmf, spectral::parse_spectrum("D65"), image.bins, spectral::LightUnits::Absolute)
+          .row(1)
+          .sum();
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> weights;
   for (std::size_t l = 0; l < image.lights.size(); ++l) {
     std::string spec = "D65";
     for (const Light& light : lights)
       if (light.name == image.lights[l].name) spec = light.spectrum_spec;
     spectral::SpecContext ctx{"lights[" + std::to_string(l) + "].spectrum", opts.spectrum_base_dir};
-    weights.push_back(spectral::relight_weights(cmf, spectral::parse_spectrum(spec, ctx), image.bins));
+    weights.push_back(spectral::relight_weights(cmf, spectral::parse_spectrum(spec, ctx), image.bins,
+                                               spectral::LightUnits::Absolute) /
+                      y_d65);
   }
   const double scale = std::exp2(opts.exposure_ev);
   const std::size_t pixels = image.pixel_count();

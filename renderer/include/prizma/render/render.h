@@ -71,7 +71,8 @@ struct PreviewOptions {
   std::filesystem::path spectrum_base_dir;  // csv: spectra resolve against this folder
 };
 
-// Relights every light with its default spectrum (relative to white, summed over lights), converts
+// Relights every light with its default spectrum (in units where D65 at scale 1 makes a perfect
+// white Y = 1, so "D65*0.2" is a fifth as bright; summed over lights), converts
 // XYZ → linear sRGB → sRGB-encoded 8-bit and writes a PNG (or any OpenImageIO format by extension)
 // atomically. Throws InputError for an unknown spectrum spec, RuntimeError for I/O failures.
 void write_preview(const std::filesystem::path& path, const spectral::SpectralImage& image,
