@@ -48,7 +48,7 @@ def material_indices(scene):
 
 
 def main():
-    args = pd.parse_args("metamerism-demo", __doc__.splitlines()[0], 192, 64, 48, 16)
+    args = pd.parse_args("metamerism-demo", __doc__.splitlines()[0], 192, 64, 48, 32)
     out = args.out
     tools = pd.Tools()
     split_light = "F11"
@@ -130,13 +130,16 @@ def main():
         role = "match" if light == MATCH_LIGHT else ("split" if light == split_light else "")
         rows.append([light, role, "%.2f" % de])
     for light in (MATCH_LIGHT, split_light):
-        pd.run([tools.relight, out / "metamers.exr"] + pd.relight_args(base, light) + ["-o", out / ("relit_%s.png" % light)],
-               quiet=True)
+        # Displayed adapted to D65 (Bradford), as the eye adapts to a light; the measurement above is
+        # in CIELAB relative to each light's own white.
+        pd.run([tools.relight, out / "metamers.exr"] + pd.relight_args(base, light) +
+               ["--adapt", "-o", out / ("relit_%s.png" % light)], quiet=True)
 
     # Figures: the two relit images, the spectra.
     pd.figure_of_images([(out / ("relit_%s.png" % MATCH_LIGHT), "%s: ΔE00 = %.2f" % (MATCH_LIGHT, measured[MATCH_LIGHT])),
                          (out / ("relit_%s.png" % split_light), "%s: ΔE00 = %.2f" % (split_light, measured[split_light]))],
-                        out / "metamers_side_by_side.png", title="One render, two lights")
+                        out / "metamers_side_by_side.png", title="One render, two lights",
+                        crop=pd.bounding_box(masks[0] | masks[1], 0.1))
     fig, ax = plt.subplots(figsize=(6.4, 3.6))
     ax.plot(grid, a1_fine, color="tab:green", label="left albedo (%s)" % albedo_spec)
     ax.plot(grid, np.clip(a2, 0, 1), color="tab:purple", label="right albedo (designed metamer)")

@@ -172,13 +172,26 @@ def read_spectrum_csv(path):
     return a[:, 0], a[:, 1]
 
 
-def figure_of_images(items, out_path, title=None, width_in=3.2):
-    """A row of images with captions: items = [(png_path, caption), …]."""
+def bounding_box(mask, margin=0.15):
+    """(y0, y1, x0, x1) around the True pixels of `mask`, grown by `margin` of the larger side, square."""
+    ys, xs = np.nonzero(mask)
+    h, w = mask.shape
+    cy, cx = 0.5 * (ys.min() + ys.max()), 0.5 * (xs.min() + xs.max())
+    half = 0.5 * max(ys.max() - ys.min(), xs.max() - xs.min()) * (1 + 2 * margin) + 1
+    y0, y1 = int(max(0, cy - half)), int(min(h, cy + half + 1))
+    x0, x1 = int(max(0, cx - half)), int(min(w, cx + half + 1))
+    return y0, y1, x0, x1
+
+
+def figure_of_images(items, out_path, title=None, width_in=3.2, crop=None):
+    """A row of images with captions: items = [(png_path, caption), …]; crop = (y0, y1, x0, x1)."""
     fig, axes = plt.subplots(1, len(items), figsize=(width_in * len(items), width_in + 0.5))
     if len(items) == 1:
         axes = [axes]
     for ax, (png, caption) in zip(axes, items):
         img, _, _ = read_image(png)
+        if crop is not None:
+            img = img[crop[0]:crop[1], crop[2]:crop[3]]
         ax.imshow(np.clip(img[:, :, :3], 0, 1), interpolation="nearest")
         ax.set_title(caption, fontsize=9)
         ax.axis("off")

@@ -92,9 +92,11 @@ def main():
     lights = {"D65": "D65", "hide": "csv:%s" % (out / "light_hide.csv"), "reveal": "csv:%s" % (out / "light_reveal.csv")}
     measured, rows = {}, []
     for key, spec in lights.items():
-        for ext in ("exr", "png"):
-            pd.run([tools.relight, out / "mri.exr"] + pd.relight_args(base, spec) + ["-o", out / ("relit_%s.%s" % (key, ext))],
-                   quiet=True)
+        pd.run([tools.relight, out / "mri.exr"] + pd.relight_args(base, spec) + ["-o", out / ("relit_%s.exr" % key)],
+               quiet=True)
+        # Displayed adapted to D65 (Bradford); the measurement is in CIELAB relative to the light's white.
+        pd.run([tools.relight, out / "mri.exr"] + pd.relight_args(base, spec) +
+               ["--adapt", "-o", out / ("relit_%s.png" % key)], quiet=True)
         xyz = pd.xyz_image(out / ("relit_%s.exr" % key))
         de = pd.delta_e(tools, spec, bins, pd.region_mean(xyz, mask_a), pd.region_mean(xyz, mask_b))
         measured[key] = de
@@ -102,7 +104,8 @@ def main():
     pd.figure_of_images([(out / "relit_D65.png", "D65: ΔE00 = %.1f" % measured["D65"]),
                          (out / "relit_hide.png", "hiding light: ΔE00 = %.1f" % measured["hide"]),
                          (out / "relit_reveal.png", "revealing light: ΔE00 = %.1f" % measured["reveal"])],
-                        out / "mri_side_by_side.png", title="Colin27 MRI, %s vs %s (one render)" % (a_name, b_name))
+                        out / "mri_side_by_side.png", title="Colin27 MRI, %s vs %s (one render)" % (a_name, b_name),
+                        crop=pd.bounding_box(mask_a | mask_b, 0.05))
     fig, ax = plt.subplots(figsize=(6.4, 3.4))
     for name, colour in (("a", "tab:green"), ("b", "tab:purple")):
         ll, vv = pd.read_spectrum_csv(out / ("albedo_%s.csv" % name))
