@@ -133,12 +133,12 @@ def main():
         # Displayed adapted to D65 (Bradford), as the eye adapts to a light; the measurement above is
         # in CIELAB relative to each light's own white.
         pd.run([tools.relight, out / "metamers.exr"] + pd.relight_args(base, light) +
-               ["--adapt", "-o", out / ("relit_%s.png" % light)], quiet=True)
+               ["--adapt", "--exposure", "1", "-o", out / ("relit_%s.png" % light)], quiet=True)
 
     # Figures: the two relit images, the spectra.
     pd.figure_of_images([(out / ("relit_%s.png" % MATCH_LIGHT), "%s: ΔE00 = %.2f" % (MATCH_LIGHT, measured[MATCH_LIGHT])),
                          (out / ("relit_%s.png" % split_light), "%s: ΔE00 = %.2f" % (split_light, measured[split_light]))],
-                        out / "metamers_side_by_side.png", title="One render, two lights",
+                        out / "metamers_side_by_side.png", title="One render, two lights (displayed adapted to D65, +1 EV)",
                         crop=pd.bounding_box(masks[0] | masks[1], 0.1))
     fig, ax = plt.subplots(figsize=(6.4, 3.6))
     ax.plot(grid, a1_fine, color="tab:green", label="left albedo (%s)" % albedo_spec)
