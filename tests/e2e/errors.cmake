@@ -1,0 +1,102 @@
+# Bad input files through the executables (docs/errors.md): truncated and mis-sized volumes, corrupt
+# NIfTI, broken scenes, bad spectra, bad spectral EXR files. Each test checks, with
+# tests/e2e/errors/check-error, the exit code, a single stderr line "<prog>: error: <input>: <reason>"
+# naming the bad file, no output file (and no temporary) left behind, or an existing output untouched.
+# The bad files are written at test time by tests/e2e/errors/make-fixtures (fixture errors_files).
+set(_errors_work ${PRIZMA_E2E_WORK}/errors)
+set(_errors_dir ${PRIZMA_E2E_DIR}/errors)
+find_program(PRIZMA_SYSTEM_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT PRIZMA_SYSTEM_PYTHON3)
+  message(STATUS "tests/e2e/errors.cmake: /usr/bin/python3 not found, bad-file tests skipped")
+  return()
+endif()
+
+add_test(NAME errors.e2e.fixtures COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/make-fixtures ${_errors_work})
+set_tests_properties(errors.e2e.fixtures PROPERTIES FIXTURES_SETUP errors_files LABELS errors)
+
+# prizma_error_e2e(NAME TOOL RC INPUT_REGEX REASON_REGEX OUTPUT [EXISTING] ARGS...)
+function(prizma_error_e2e name tool rc input reason output)
+  set(args ${ARGN})
+  set(existing "")
+  list(GET args 0 first)
+  if(first STREQUAL "EXISTING")
+    set(existing --existing)
+    list(REMOVE_AT args 0)
+  endif()
+  add_test(NAME errors.e2e.${name}
+           COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-error --workdir ${_errors_work} --rc ${rc}
+                   --input ${input} --reason ${reason} --output ${output} ${existing} -- $<TARGET_FILE:${tool}> ${args})
+  set_tests_properties(errors.e2e.${name} PROPERTIES FIXTURES_REQUIRED errors_files LABELS errors
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+endfunction()
+
+if(TARGET prizma-render)
+  # prizma_render_error(NAME SCENE INPUT_REGEX REASON_REGEX [EXISTING]): render SCENE -o <NAME>.exr, expect exit 2.
+  function(prizma_render_error name scene input reason)
+    prizma_error_e2e(render_${name} prizma-render 2 "${input}" "${reason}" render_${name}.exr ${ARGN}
+                     ${scene} -o render_${name}.exr)
+  endfunction()
+  # Raw volumes.
+  prizma_render_error(raw_truncated raw_truncated.json "trunc_4x4x4_uint8\\.raw" "size|truncated")
+  prizma_render_error(raw_size_mismatch raw_size_mismatch.json "block_4x4x4_uint8\\.raw" "size")
+  prizma_render_error(raw_unparsable_name raw_unparsable_name.json "noname\\.raw" "name")
+  prizma_render_error(raw_too_large raw_too_large.json "block_4x4x4_uint8\\.raw" "too large")
+  prizma_render_error(raw_missing raw_missing.json "no_such_volume_8x8x8_uint8\\.raw" "(?i)no such file")
+  prizma_render_error(raw_existing_output raw_truncated.json "trunc_4x4x4_uint8\\.raw" "size|truncated" EXISTING)
+  # NIfTI.
+  prizma_render_error(nifti_truncated_gz nifti_truncated_nii_gz.json "truncated\\.nii\\.gz" ".")
+  prizma_render_error(nifti_corrupt_gz nifti_corrupt_nii_gz.json "corrupt\\.nii\\.gz" ".")
+  prizma_render_error(nifti_complex nifti_complex_nii.json "complex\\.nii" "unsupported|COMPLEX")
+  prizma_render_error(nifti_rgb nifti_rgb_nii.json "rgb\\.nii" "unsupported|RGB")
+  prizma_render_error(nifti_short nifti_short_nii.json "short\\.nii" "truncated|corrupt|read")
+  prizma_render_error(nifti_existing_output nifti_corrupt_nii_gz.json "corrupt\\.nii\\.gz" "." EXISTING)
+  # Scene files.
+  prizma_render_error(scene_malformed scene_malformed.json "scene_malformed\\.json" "JSON|parse|syntax")
+  prizma_render_error(scene_unknown_field scene_unknown_field.json "scene_unknown_field\\.json.*albdo" "unknown")
+  prizma_render_error(scene_unknown_top_field scene_unknown_top_field.json "scene_unknown_top_field\\.json.*sampels" "unknown")
+  prizma_render_error(scene_wrong_type scene_wrong_type.json "scene_wrong_type\\.json.*samples" "must be|integer|number")
+  prizma_render_error(scene_wrong_type_camera scene_wrong_type_camera.json "scene_wrong_type_camera\\.json.*camera" "object")
+  prizma_render_error(scene_albedo_above_one scene_albedo_above_one.json "scene_albedo_above_one\\.json.*albedo" "1")
+  prizma_render_error(scene_anisotropy_one scene_anisotropy_one.json "scene_anisotropy_one\\.json.*anisotropy" "1")
+  prizma_render_error(scene_negative_extinction scene_negative_extinction.json "scene_negative_extinction\\.json.*extinction" "0|negative")
+  prizma_render_error(scene_zero_width scene_zero_width.json "scene_zero_width\\.json.*width" "0|positive")
+  prizma_render_error(scene_unknown_spectrum scene_unknown_spectrum.json "scene_unknown_spectrum\\.json.*albedo" "D66")
+  prizma_render_error(scene_no_lights scene_no_lights.json "scene_no_lights\\.json.*lights" "light|empty")
+  prizma_render_error(scene_bins_outside_cmf scene_bins_outside_cmf.json "scene_bins_outside_cmf\\.json.*bins" "360|830")
+  prizma_render_error(scene_existing_output scene_unknown_field.json "scene_unknown_field\\.json" "unknown" EXISTING)
+  # Spectra (CSV files named by the scene).
+  prizma_render_error(spectrum_unsorted spectrum_unsorted.json "unsorted\\.csv" "increasing|sorted|order")
+  prizma_render_error(spectrum_nan spectrum_nan.json "nan\\.csv" "nan|NaN|finite|number")
+  prizma_render_error(spectrum_negative spectrum_negative.json "spectrum_negative\\.json.*albedo|negative\\.csv" "-0\\.2|negative|\\[0, 1\\]")
+  # A spectrum outside the bins is zero there by definition (spectrum.h), so a material or a light's
+  # default spectrum that misses the bins is valid for the renderer; prizma-relight refuses a light
+  # with no energy inside the bins (below).
+endif()
+
+if(TARGET prizma-relight)
+  # prizma_relight_error(NAME EXR REASON_REGEX [EXISTING]): relight EXR -o <NAME>.png, expect exit 2.
+  function(prizma_relight_error name exr reason)
+    string(REPLACE "." "\\." input "${exr}")
+    prizma_error_e2e(relight_${name} prizma-relight 2 "${input}" "${reason}" relight_${name}.png ${ARGN}
+                     ${exr} -o relight_${name}.png)
+  endfunction()
+  prizma_relight_error(truncated truncated.exr ".")
+  prizma_relight_error(not_an_exr not_an_exr.exr "EXR|OpenEXR")
+  prizma_relight_error(rgb_only rgb_only.exr "spectral")
+  prizma_relight_error(emissive_only emissive_only.exr "emissive|S0")
+  prizma_relight_error(inconsistent_edges inconsistent_edges.exr "edge|centre|center")
+  prizma_relight_error(edge_count edge_count.exr "6 edges for 4 spectral channels")
+  prizma_relight_error(unsorted_edges unsorted_edges.exr "edge|increasing")
+  prizma_relight_error(nan_pixel nan_pixel.exr "NaN|nan|finite")
+  prizma_relight_error(truncated_existing_output truncated.exr "." EXISTING)
+  prizma_relight_error(not_an_exr_existing_exr not_an_exr.exr "EXR|OpenEXR" EXISTING)
+  # Light spectra: outside the colour matching range, unsorted CSV.
+  prizma_error_e2e(relight_light_outside_bins prizma-relight 2 "light" "no energy" relight_light_ir.png
+                   good.exr --light csv:infrared.csv -o relight_light_ir.png)
+  prizma_error_e2e(relight_light_far_infrared prizma-relight 2 "light" "no energy" relight_light_ir2.png
+                   good.exr --light gaussian:1200:10 -o relight_light_ir2.png)
+  prizma_error_e2e(relight_light_unsorted_csv prizma-relight 2 "unsorted\\.csv" "increasing" relight_light_unsorted.png
+                   good.exr --light csv:unsorted.csv -o relight_light_unsorted.png)
+  prizma_error_e2e(relight_light_nan_csv prizma-relight 2 "nan\\.csv" "finite" relight_light_nan.png EXISTING
+                   good.exr --light csv:nan.csv -o relight_light_nan.png)
+endif()
