@@ -68,7 +68,8 @@ def main():
     for i in (left, right):
         cal["materials"][i]["albedo"] = "csv:calibration_albedo.csv"
     pd.write_scene(cal, out / "calibration.json")
-    pd.render(tools, out / "calibration.json", out / "calibration.exr", args.size, args.spp, args.seed)
+    # Twice the samples: its noise goes into the design of the right albedo.
+    pd.render(tools, out / "calibration.json", out / "calibration.exr", args.size, 2 * args.spp, args.seed + 1)
     t_cal, _ = pd.combined_transport(out / "calibration.exr", base)
     # The spheres' regions: pixels where the first bin (albedo 0: no scattering, only the background
     # seen through the medium) is nearly dark, i.e. the sphere is opaque along the whole pixel.
