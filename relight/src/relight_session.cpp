@@ -29,6 +29,18 @@ std::vector<LightSpec> read_default_lights(const spectral::SpectralImage& image,
       throw InputError(source, std::string("prizma:lights is not valid JSON: ") + e.what());
     }
   }
+  // A file that announces two or more lights must hold a layer for each of them.
+  if (lights.is_array() && lights.size() >= 2) {
+    for (const auto& entry : lights) {
+      const std::string name = entry.is_object() ? entry.value("name", std::string()) : std::string();
+      if (std::find(names.begin(), names.end(), name) == names.end()) {
+        std::string known;
+        for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+        throw InputError(source, "prizma:lights announces light \"" + name + "\" but the file has no layer for it (layers: " +
+                                     known + ")");
+      }
+    }
+  }
   std::vector<LightSpec> out;
   for (std::size_t l = 0; l < names.size(); ++l) {
     std::string spec = "D65";
