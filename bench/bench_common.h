@@ -173,17 +173,34 @@ inline spectral::SpectralImage cached_render(const render::Scene& scene, const f
   return img;
 }
 
+// Pixels whose camera rays (nearly) all miss the medium: every value of the reference exactly 0 or 1
+// (the unit environment seen directly, no directional light). 1 = background.
+inline std::vector<char> background_mask(const spectral::SpectralImage& ref) {
+  std::vector<char> mask(ref.pixel_count(), 1);
+  const std::size_t nb = static_cast<std::size_t>(ref.bins.size());
+  for (const auto& layer : ref.lights)
+    for (std::size_t p = 0; p < ref.pixel_count(); ++p)
+      for (std::size_t i = 0; i < nb; ++i) {
+        const float v = layer.data[p * nb + i];
+        if (v != 0.0f && v != 1.0f) mask[p] = 0;
+      }
+  return mask;
+}
+
 // Relative RMSE of the transport over every pixel, light and bin: sqrt(Σ(x − r)² / Σ r²). With
 // `ref_variance_sum` > 0 (Σ of the reference's variance of the mean), the reference's own noise is
 // subtracted from the numerator (E[(x − r)²] = (x − E r)² + Var r).
+// `skip` (optional, per pixel): pixels left out (e.g. the background).
 inline double relative_rmse(const spectral::SpectralImage& x, const spectral::SpectralImage& ref,
-                            double* corrected = nullptr) {
+                            double* corrected = nullptr, const std::vector<char>* skip = nullptr) {
   double num = 0.0, den = 0.0, var = 0.0;
+  const std::size_t nb = static_cast<std::size_t>(ref.bins.size());
   for (std::size_t l = 0; l < ref.lights.size(); ++l) {
     const auto& a = x.lights[l].data;
     const auto& r = ref.lights[l].data;
     const auto& rv = ref.lights[l].variance;
     for (std::size_t k = 0; k < r.size(); ++k) {
+      if (skip && (*skip)[k / nb]) continue;
       const double d = static_cast<double>(a[k]) - r[k];
       num += d * d;
       den += static_cast<double>(r[k]) * r[k];

@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
 
   std::ostringstream csv;
   csv << "scene,method,spp,seconds,paths,collisions,shadow_steps,rel_rmse,rel_rmse_corrected,mean_de00,"
-         "ref_spp,ref_rel_noise,wavelength_independent\n";
+         "ref_spp,ref_rel_noise,wavelength_independent,rel_rmse_volume_corrected\n";
   csv << std::setprecision(6);
   try {
     for (const std::string& name : o.scenes) {
@@ -100,6 +100,7 @@ int main(int argc, char** argv) {
       const double ref_noise = std::sqrt(ref_var / ref_sq);
       Eigen::Vector3d white;
       const auto ref_xyz = pb::relight_all(ref, "D65", &white);
+      const std::vector<char> background = pb::background_mask(ref);
 
       for (const Method& m : methods) {
         pr::Scene s = scene;
@@ -117,10 +118,12 @@ int main(int argc, char** argv) {
           const double seconds = st.wall_seconds;
           double corrected = 0.0;
           const double err = pb::relative_rmse(img, ref, &corrected);
+          double vol_corrected = 0.0;
+          pb::relative_rmse(img, ref, &vol_corrected, &background);
           const auto de = pb::delta_e_stats(pb::relight_all(img, "D65"), ref_xyz, white);
           csv << name << ',' << m.name << ',' << n << ',' << seconds << ',' << st.paths << ',' << st.collisions << ','
               << st.shadow_steps << ',' << err << ',' << corrected << ',' << de.mean << ',' << o.ref_spp << ','
-              << ref_noise << ',' << (st.wavelength_independent ? 1 : 0) << '\n';
+              << ref_noise << ',' << (st.wavelength_independent ? 1 : 0) << ',' << vol_corrected << '\n';
           std::cerr << "  " << std::setw(16) << std::left << m.name << std::right << " spp " << std::setw(5) << n
                     << "  " << std::fixed << std::setprecision(3) << std::setw(8) << seconds << " s  rel.RMSE "
                     << std::setprecision(4) << err << "  dE00 " << de.mean << std::defaultfloat << "\n";
