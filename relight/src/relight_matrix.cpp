@@ -13,11 +13,7 @@ RelightMatrix::RelightMatrix(const spectral::BinLayout& bins, const std::vector<
   // Per light: exact ∫_{bin} E·cmf dλ (normalised unless absolute), times the light's scale.
   m_per_light.reserve(lights.size());
   for (const LightSpec& light : lights) {
-    if (light.off) {
-      m_per_light.push_back(Matrix3Xd::Zero(3, m_bins));
-      continue;
-    }
-    m_per_light.push_back(spectral::relight_weights(cmf, light.spectrum, bins, opts.units) * light.scale);
+    m_per_light.push_back(spectral::relight_weights(cmf, light, bins, opts.units));
     m_mix_white += m_per_light.back().rowwise().sum();
   }
   // Bradford from the mix's white (at its own luminance) to D65 at the same luminance.

@@ -8,7 +8,7 @@
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/spectrum_spec.h"
+#include "prizma/spectral/light_spectrum.h"
 
 namespace prizma::render {
 
@@ -16,21 +16,16 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
                    const std::vector<Light>& lights, const PreviewOptions& opts) {
   const int nb = image.bins.size();
   const auto& cmf = spectral::ColorMatching::get(spectral::Observer::Cie1931_2deg);
-  // Per light: 3×n weights of its default spectrum (exact bin integrals), in units where D65 at
-  // scale 1 gives a perfect white Y = 1, so spec scales ("D65*0.2") keep their relative strength.
-  const double y_d65 =
-      spectral::relight_weights(cmf, spectral::parse_spectrum("D65"), image.bins, spectral::LightUnits::Absolute)
-          .row(1)
-          .sum();
+  // Per light: 3×n weights of its default spectrum (exact bin integrals), read as prizma-relight
+  // reads a light: normalised so that a perfect white has Y = 1, then the spec's trailing scale
+  // ("D65*0.2" stays a fifth as bright).
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> weights;
   for (std::size_t l = 0; l < image.lights.size(); ++l) {
     std::string spec = "D65";
     for (const Light& light : lights)
       if (light.name == image.lights[l].name) spec = light.spectrum_spec;
     spectral::SpecContext ctx{"lights[" + std::to_string(l) + "].spectrum", opts.spectrum_base_dir};
-    weights.push_back(spectral::relight_weights(cmf, spectral::parse_spectrum(spec, ctx), image.bins,
-                                               spectral::LightUnits::Absolute) /
-                      y_d65);
+    weights.push_back(spectral::relight_weights(cmf, spectral::parse_light_spectrum(spec, ctx), image.bins));
   }
   const double scale = std::exp2(opts.exposure_ev);
   const std::size_t pixels = image.pixel_count();

@@ -1,0 +1,32 @@
+#pragma once
+// LightSpectrum: a light's spectrum as the user gave it ("D65", "gaussian:550:5*2", "off"), with the
+// trailing scale kept apart from the spectrum so that normalisation applies to the bare spectrum
+// and the scale after it (design.md: a light at scale 1 makes a perfect white Y = 1, so "D65*0.5"
+// gives exactly half the image of "D65"). Shared by prizma-relight and prizma-render's preview.
+#include <Eigen/Core>
+#include <string>
+#include <string_view>
+
+#include "prizma/spectral/colour_matching.h"
+#include "prizma/spectral/spectrum.h"
+#include "prizma/spectral/spectrum_spec.h"
+
+namespace prizma::spectral {
+
+struct LightSpectrum {
+  std::string text = "D65";  // the spec as given, echoed into output metadata
+  Spectrum spectrum;         // the spectrum without the trailing scale
+  double scale = 1.0;        // trailing "*<factor>" factors, applied after normalisation
+  bool off = false;          // "off" (or scale 0): the light contributes nothing
+};
+
+// Parses "off", or any parse_spectrum spec with optional trailing "*<factor>" scales. Throws
+// InputError naming ctx.input for bad specs or negative / non-finite scales.
+LightSpectrum parse_light_spectrum(std::string_view text, const SpecContext& ctx = {});
+
+// relight_weights() of the bare spectrum times the scale; a zero matrix for a light that is off.
+Eigen::Matrix<double, 3, Eigen::Dynamic> relight_weights(const ColorMatching& cmf, const LightSpectrum& light,
+                                                          const BinLayout& bins,
+                                                          LightUnits units = LightUnits::RelativeToWhite);
+
+}  // namespace prizma::spectral
