@@ -119,4 +119,11 @@ Eigen::MatrixXd bspline_basis(const Eigen::VectorXd& x, double lo, double hi, in
   return out;
 }
 
+std::vector<double> design_grid(double lo_nm, double hi_nm, double step_nm) {
+  const int nodes = std::max(2, static_cast<int>(std::lround((hi_nm - lo_nm) / step_nm)) + 1);
+  std::vector<double> lambda(static_cast<std::size_t>(nodes));
+  for (int j = 0; j < nodes; ++j) lambda[j] = (j == nodes - 1) ? hi_nm : lo_nm + (hi_nm - lo_nm) * j / (nodes - 1);
+  return lambda;
+}
+
 }  // namespace prizma::spectral::detail

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <optional>
+#include <vector>
 
 namespace prizma::spectral::detail {
 
@@ -31,5 +32,9 @@ AscentResult projected_ascent(const std::function<double(const Eigen::VectorXd&)
 // (rows: points, columns: functions). Every row sums to 1 and every entry is in [0, 1], so
 // coefficients in [0, 1] give a curve in [0, 1] (convex hull property).
 Eigen::MatrixXd bspline_basis(const Eigen::VectorXd& x, double lo, double hi, int count);
+
+// Evenly spaced wavelengths from lo to hi (both included, the last exactly hi) about step apart,
+// at least 2: the output grid of the designed spectra.
+std::vector<double> design_grid(double lo_nm, double hi_nm, double step_nm);
 
 }  // namespace prizma::spectral::detail

@@ -72,13 +72,9 @@ LightDesignResult design_light(const Spectrum& albedo_a, const Spectrum& albedo_
   // is exactly what was optimised), or a B-spline basis for a free-form light.
   std::vector<Spectrum> working;
   if (primaries.empty()) {
-    const int nodes = std::max(2, static_cast<int>(std::lround((hi_nm - lo_nm) / options.step_nm)) + 1);
-    std::vector<double> lambda(static_cast<size_t>(nodes));
-    Eigen::VectorXd lambda_vec(nodes);
-    for (int j = 0; j < nodes; ++j) {
-      lambda[j] = (j == nodes - 1) ? hi_nm : lo_nm + (hi_nm - lo_nm) * j / (nodes - 1);
-      lambda_vec[j] = lambda[j];
-    }
+    const std::vector<double> lambda = detail::design_grid(lo_nm, hi_nm, options.step_nm);
+    const int nodes = static_cast<int>(lambda.size());
+    const Eigen::VectorXd lambda_vec = Eigen::Map<const Eigen::VectorXd>(lambda.data(), nodes);
     const Eigen::MatrixXd basis = detail::bspline_basis(lambda_vec, lo_nm, hi_nm, options.basis_size);
     for (int j = 0; j < options.basis_size; ++j) {
       const Eigen::VectorXd column = basis.col(j);

@@ -89,13 +89,9 @@ MetamerResult design_metamer(const Spectrum& albedo, const Spectrum& match_light
   const Eigen::Vector3d white2 = m2.rowwise().sum();
 
   // The basis tabulated on the output grid; its bin averages give the linear maps coefficient → XYZ.
-  const int nodes = std::max(2, static_cast<int>(std::lround((hi_nm - lo_nm) / options.step_nm)) + 1);
-  std::vector<double> lambda(static_cast<size_t>(nodes));
-  Eigen::VectorXd lambda_vec(nodes);
-  for (int j = 0; j < nodes; ++j) {
-    lambda[j] = (j == nodes - 1) ? hi_nm : lo_nm + (hi_nm - lo_nm) * j / (nodes - 1);
-    lambda_vec[j] = lambda[j];
-  }
+  const std::vector<double> lambda = detail::design_grid(lo_nm, hi_nm, options.step_nm);
+  const int nodes = static_cast<int>(lambda.size());
+  const Eigen::VectorXd lambda_vec = Eigen::Map<const Eigen::VectorXd>(lambda.data(), nodes);
   const int k = options.basis_size;
   const Eigen::MatrixXd basis = detail::bspline_basis(lambda_vec, lo_nm, hi_nm, k);
   Eigen::MatrixXd averages(bins.size(), k);
