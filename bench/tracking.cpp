@@ -186,10 +186,10 @@ void bin_cost(benchmark::State& state, const pr::Scene& scene, int n) {
 // render() on 1 and 2 threads, interleaved: speed-up = t1 / t2.
 void threads(benchmark::State& state, const pr::Scene& base) {
   pr::Scene s = base;
-  s.camera.width = 48;
-  s.camera.height = 48;
+  s.camera.width = 96;
+  s.camera.height = 96;
   s.settings.sample_begin = 0;
-  s.settings.sample_end = 8;
+  s.settings.sample_end = 16;
   double t1 = 0, t2 = 0;
   int k = 0;
   for (auto _ : state) {
