@@ -98,13 +98,25 @@ Volume load_nifti_volume(const std::filesystem::path& path) {
 
   // Voxels, read here rather than by nifti_image_load, which zero-fills a short read and succeeds.
   if (nim->iname == nullptr || nim->iname_offset < 0) throw InputError(input, "header names no voxel data");
+  // The buffer grows only as data arrives (in chunks, capacity doubling up to the declared size), so
+  // a header that claims far more voxels than the file holds costs one chunk, not the claimed size.
   const std::size_t nbytes = count * file_bytes;
-  std::vector<unsigned char> raw(nbytes);
+  constexpr std::size_t kChunkBytes = std::size_t{64} << 20;
+  std::vector<unsigned char> raw;
   {
     znzFile fp = znzopen(nim->iname, "rb", nifti_is_gzfile(nim->iname));
     if (znz_isnull(fp)) throw InputError(input, "cannot open the voxel data " + std::string(nim->iname));
-    const bool seek_ok = znzseek(fp, nim->iname_offset, SEEK_SET) >= 0;
-    const std::size_t got = seek_ok ? znzread(raw.data(), 1, nbytes, fp) : 0;
+    std::size_t got = 0;
+    if (znzseek(fp, nim->iname_offset, SEEK_SET) >= 0) {
+      while (got < nbytes) {
+        const std::size_t want = std::min(kChunkBytes, nbytes - got);
+        if (raw.capacity() < got + want) raw.reserve(std::min(nbytes, std::max(got + want, 2 * raw.capacity())));
+        raw.resize(got + want);
+        const std::size_t n = znzread(raw.data() + got, 1, want, fp);
+        got += n;
+        if (n != want) break;
+      }
+    }
     znzclose(fp);
     if (got != nbytes) {
       throw InputError(input, "cannot read the voxel data: file corrupt or truncated (needs " + std::to_string(nbytes) +
