@@ -17,8 +17,9 @@ using testing::make_material;
 using testing::pixel_average;
 using spectral::Spectrum;
 
-// Tolerance of the statistical comparisons: 4 standard errors (two-sided chance 6e-5 each).
-constexpr double kSe = 4.0;
+// Tolerance of the statistical comparisons: 3 standard errors (two-sided chance 0.27 % each; the
+// seeds are fixed, so a pass is reproducible).
+constexpr double kSe = 3.0;
 
 TEST(RenderPhysics, BeerLambertPerBin) {
   // Absorbing box (albedo 0), σt(λ) linear from 0.5 at 400 nm to 3 at 700 nm, depth d = 1. The bin
