@@ -8,6 +8,7 @@
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
+#include "spectral/brute_force.h"
 
 using namespace prizma::spectral;
 
@@ -19,16 +20,7 @@ Eigen::Vector2d xy_of_light(const std::string& name) {
   return chromaticity(cie1931().integrate(parse_spectrum(name)));
 }
 
-// Brute-force midpoint rule, independent of integrate_product.
-double midpoint(const Spectrum& a, const Spectrum& b, double lo, double hi, int n) {
-  const double h = (hi - lo) / n;
-  double sum = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double x = lo + (i + 0.5) * h;
-    sum += a.eval(x) * b.eval(x);
-  }
-  return sum * h;
-}
+using prizma::spectral::test_support::midpoint;
 
 }  // namespace
 

@@ -7,6 +7,7 @@
 
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum.h"
+#include "spectral/brute_force.h"
 
 using prizma::spectral::BinLayout;
 using prizma::spectral::InputError;
@@ -30,16 +31,7 @@ void expect_invalid(std::vector<double> lam, std::vector<double> val, const std:
 // ∫ (u − 400)(u − 350)/10⁴ du, the antiderivative of the product of the two ramps used below.
 double ramp_product_antiderivative(double u) { return (u * u * u / 3.0 - 375.0 * u * u + 140000.0 * u) / 1e4; }
 
-// Brute-force midpoint rule with n steps (independent of the exact integrator).
-double midpoint(const Spectrum& a, const Spectrum& b, double lo, double hi, int n) {
-  const double h = (hi - lo) / n;
-  double sum = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double x = lo + (i + 0.5) * h;
-    sum += a.eval(x) * b.eval(x);
-  }
-  return sum * h;
-}
+using prizma::spectral::test_support::midpoint;
 
 }  // namespace
 
