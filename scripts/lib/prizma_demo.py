@@ -202,6 +202,18 @@ def figure_of_images(items, out_path, title=None, width_in=3.2, crop=None):
     plt.close(fig)
 
 
+def finish_spectra_plot(fig, ax, ax_lights, out_path):
+    """Labels the lights' axis (relative power), merges both axes' legends and saves the figure."""
+    ax_lights.set_ylabel("relative power")
+    ax_lights.set_ylim(0, 1.05)
+    h1, l1 = ax.get_legend_handles_labels()
+    h2, l2 = ax_lights.get_legend_handles_labels()
+    ax.legend(h1 + h2, l1 + l2, fontsize=7, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(out_path, dpi=80)
+    plt.close(fig)
+
+
 def write_table(path, header, rows):
     """A Markdown table, also printed."""
     lines = ["| " + " | ".join(header) + " |", "|" + "|".join(" --- " for _ in header) + "|"]
