@@ -11,8 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/colour.h"
+#include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/light_design.h"
 #include "prizma/spectral/metamer_design.h"
@@ -60,6 +62,11 @@ struct TabulateCommand {
   double from_nm = 380.0;
   double to_nm = 780.0;
   double step_nm = 1.0;
+};
+
+struct WeightsCommand {
+  std::string light = "D65";
+  std::string output;
 };
 
 struct DeltaECommand {
@@ -216,6 +223,29 @@ int run_tabulate(const TabulateCommand& cmd) {
   return ps::kExitOk;
 }
 
+// The relighter's matrix for one light: XYZ of a pixel = Σ_bins weight · transport. Lets scripts
+// predict relit colours from transport spectra without re-implementing the colour matching.
+int run_weights(const WeightsCommand& cmd, const CommonOptions& common) {
+  const ps::ColourSetting colour = colour_setting(common);
+  const ps::Spectrum light = parse_option(cmd.light, "--light");
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> w =
+      ps::relight_weights(ps::ColorMatching::get(colour.observer), light, colour.bins);
+  ps::write_atomically(cmd.output, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw ps::RuntimeError(tmp.string() + ": cannot open for writing");
+    char line[160];
+    out << "lo_nm,hi_nm,X,Y,Z\n";
+    for (int i = 0; i < colour.bins.size(); ++i) {
+      std::snprintf(line, sizeof line, "%.9g,%.9g,%.17g,%.17g,%.17g\n", colour.bins.lo_nm(i), colour.bins.hi_nm(i),
+                    w(0, i), w(1, i), w(2, i));
+      out << line;
+    }
+    out.close();
+    if (!out) throw ps::RuntimeError(tmp.string() + ": write failed");
+  });
+  return ps::kExitOk;
+}
+
 int run_delta_e(const DeltaECommand& cmd, const CommonOptions& common) {
   const ps::ColourSetting colour = colour_setting(common);
   const ps::Spectrum light = parse_option(cmd.light, "--light");
@@ -285,6 +315,12 @@ int main(int argc, char** argv) {
   sub_delta->add_option("--xyz-a", delta.xyz_a, "X,Y,Z of the first colour")->required()->expected(3)->delimiter(',');
   sub_delta->add_option("--xyz-b", delta.xyz_b, "X,Y,Z of the second colour")->required()->expected(3)->delimiter(',');
 
+  WeightsCommand weights;
+  CLI::App* sub_weights = app.add_subcommand(
+      "weights", "write the relighter's X,Y,Z weights per bin for --light (white-normalised: sum of Y = 1)");
+  sub_weights->add_option("--light", weights.light, "light spectrum")->capture_default_str();
+  sub_weights->add_option("-o,--output", weights.output, "output CSV (lo_nm, hi_nm, X, Y, Z)")->required();
+
   TabulateCommand tabulate;
   CLI::App* sub_tabulate = app.add_subcommand("tabulate", "write a spectrum spec as a CSV table (for scripts and plots)");
   sub_tabulate->add_option("--spectrum", tabulate.spectrum, "spectrum spec")->required();
@@ -298,6 +334,7 @@ int main(int argc, char** argv) {
     if (*sub_metamer) return run_metamer(metamer, common);
     if (*sub_light) return run_light(light, common);
     if (*sub_tabulate) return run_tabulate(tabulate);
+    if (*sub_weights) return run_weights(weights, common);
     return run_delta_e(delta, common);
   });
 }

@@ -48,7 +48,7 @@ def material_indices(scene):
 
 
 def main():
-    args = pd.parse_args("metamerism-demo", __doc__.splitlines()[0], 192, 64, 48, 32)
+    args = pd.parse_args("metamerism-demo", __doc__.splitlines()[0], 192, 64, 64, 128)
     out = args.out
     tools = pd.Tools()
     split_light = "F11"

@@ -20,12 +20,21 @@ if(TARGET prizma-metamer)
   set_tests_properties(metamer.cli.light_reveal PROPERTIES LABELS e2e
                        ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
 
+  # The relighter's weights for D65 in 16 bins: 16 rows; sums are D65's white point with Y = 1
+  # (X 0.9504, Z 1.0888 for the 1931 observer, CIE 015:2018 table 3).
+  add_test(NAME metamer.cli.weights
+           COMMAND sh -c "\"$0\" --bins linear:380:780:16 weights --light D65 -o \"$1\" && awk -F, 'NR > 1 { n++; x += $3; y += $4; z += $5 } END { printf \"%d %.6f %.6f %.6f\\n\", n, x, y, z; exit !(n == 16 && y > 0.999999 && y < 1.000001 && x > 0.9494 && x < 0.9514 && z > 1.0878 && z < 1.0898) }' \"$1\""
+                   $<TARGET_FILE:prizma-metamer> ${PRIZMA_METAMER_WORK}/weights.csv)
+  set_tests_properties(metamer.cli.weights PROPERTIES LABELS e2e
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+
   # Input errors: exit 2, one line naming the input, no output file.
   foreach(case
       "bad_albedo|metamer --albedo 1.5 --match-light D65 --split-light A -o OUT|error: albedo: value 1.5"
       "unknown_light|metamer --albedo 0.5 --match-light D66 --split-light A -o OUT|error: --match-light"
       "hide_and_reveal|light --albedo-a cc:7 --albedo-b cc:16 --hide --reveal -o OUT|error: --hide/--reveal"
-      "same_albedos|light --albedo-a cc:7 --albedo-b cc:7 --reveal -o OUT|error: albedo-b")
+      "same_albedos|light --albedo-a cc:7 --albedo-b cc:7 --reveal -o OUT|error: albedo-b"
+      "weights_dark_light|--bins linear:700:780:4 weights --light box:400:500 -o OUT|error: light")
     string(REPLACE "|" ";" parts "${case}")
     list(GET parts 0 name)
     list(GET parts 1 args)
