@@ -18,9 +18,18 @@ namespace {
 
 using spectral::InputError;
 
-// Default light per layer: the spectrum recorded in prizma:lights for that name, else D65.
-std::vector<LightSpec> read_default_lights(const spectral::SpectralImage& image, const std::vector<std::string>& names,
-                                           const std::string& source) {
+struct DefaultLights {
+  std::vector<LightSpec> lights;
+  // Per layer: why the recorded spectrum cannot be used (empty when it can).
+  std::vector<std::string> errors;
+};
+
+// Default light per layer: the spectrum recorded in prizma:lights for that name, else D65. A recorded
+// spectrum that does not parse here (e.g. "csv:lamp.csv" rendered on another machine) does not stop the
+// file from opening: that layer gets an "off" placeholder carrying the recorded text, and relighting
+// fails only if the user leaves it in place.
+DefaultLights read_default_lights(const spectral::SpectralImage& image, const std::vector<std::string>& names,
+                                  const std::string& source) {
   nlohmann::json lights = nlohmann::json::array();
   if (!image.info.lights_json.empty()) {
     try {
@@ -41,7 +50,7 @@ std::vector<LightSpec> read_default_lights(const spectral::SpectralImage& image,
       }
     }
   }
-  std::vector<LightSpec> out;
+  DefaultLights out;
   for (std::size_t l = 0; l < names.size(); ++l) {
     std::string spec = "D65";
     if (lights.is_array()) {
@@ -55,7 +64,18 @@ std::vector<LightSpec> read_default_lights(const spectral::SpectralImage& image,
         }
       }
     }
-    out.push_back(parse_light_spec(spec, {source + ": prizma:lights " + names[l], {}}));
+    const std::string context = source + ": prizma:lights " + names[l];
+    try {
+      out.lights.push_back(parse_light_spec(spec, {context, {}}));
+      out.errors.emplace_back();
+    } catch (const InputError& e) {
+      LightSpec placeholder;
+      placeholder.text = spec;
+      placeholder.off = true;
+      out.lights.push_back(std::move(placeholder));
+      // Keep the inner input when it is not the context (the CSV's path, say).
+      out.errors.push_back(e.input() == context ? e.reason() : e.what());
+    }
   }
   return out;
 }
@@ -77,7 +97,9 @@ RelightSession::RelightSession(spectral::SpectralImage image, std::string source
     : m_image(std::move(image)), m_source(std::move(source)) {
   if (m_image.lights.empty()) throw InputError(m_source, "no transport layers");
   for (const auto& layer : m_image.lights) m_light_names.push_back(layer.name.empty() ? "T" : layer.name);
-  m_default_lights = read_default_lights(m_image, m_light_names, m_source);
+  DefaultLights defaults = read_default_lights(m_image, m_light_names, m_source);
+  m_default_lights = std::move(defaults.lights);
+  m_default_errors = std::move(defaults.errors);
   RelightSettings settings;
   settings.lights = m_default_lights;
   apply(std::move(settings));
@@ -155,7 +177,18 @@ void RelightSession::set_display(const std::string& display) {
   apply(std::move(s));
 }
 
+void RelightSession::check_lights_usable() const {
+  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
+    const LightSpec& light = m_settings.lights[l];
+    if (m_default_errors[l].empty() || !light.off || light.text != m_default_lights[l].text) continue;
+    throw InputError(m_source + ": prizma:lights " + m_light_names[l],
+                     "the recorded spectrum \"" + light.text + "\" cannot be used here (" + m_default_errors[l] +
+                         "); give this light a spectrum (--light " + m_light_names[l] + "=SPEC)");
+  }
+}
+
 double RelightSession::relight() {
+  check_lights_usable();
   if (!m_dirty) return 0.0;
   const auto start = std::chrono::steady_clock::now();
   m_xyz.width = m_image.width;

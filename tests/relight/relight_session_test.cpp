@@ -58,6 +58,37 @@ TEST(RelightSession, LoadsDefaultsFromPrizmaLights) {
   EXPECT_DOUBLE_EQ(session.settings().lights[1].scale, 0.5);
 }
 
+// A file rendered elsewhere may record a light as a CSV that is not here: it still opens, relighting
+// with that default fails naming the light, and giving the light a spectrum makes it work.
+TEST(RelightSession, UnusableRecordedLightFailsOnlyWhenUsed) {
+  const fs::path dir = test::scratch_dir("unusable_default");
+  const BinLayout bins = BinLayout::linear(400.0, 700.0, 12);
+  auto img = test::make_image(6, 4, bins, {"key", "back"}, [](int, int, int) { return 0.5f; });
+  img.info.lights_json = R"([{"name":"key","spectrum":"D65"},{"name":"back","spectrum":"csv:/nowhere/lamp.csv*2"}])";
+  const fs::path path = dir / "elsewhere.exr";
+  spectral::write_spectral_exr(path, img);
+
+  RelightSession session(path);
+  EXPECT_EQ(session.default_lights()[1].text, "csv:/nowhere/lamp.csv*2");
+  EXPECT_TRUE(session.default_lights()[1].off);
+  try {
+    session.relight();
+    FAIL() << "no error";
+  } catch (const spectral::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("prizma:lights back"), std::string::npos) << what;
+    EXPECT_NE(what.find("--light back=SPEC"), std::string::npos) << what;
+  }
+  session.set_light("key", "A");  // another light does not fix it
+  EXPECT_THROW(session.relight(), spectral::InputError);
+  session.set_light("back", "off");  // switching it off explicitly does
+  EXPECT_NO_THROW(session.relight());
+  const float y_key_only = session.xyz().xyz[1];
+  session.set_light("back", "D65");
+  EXPECT_NO_THROW(session.relight());
+  EXPECT_FLOAT_EQ(session.xyz().xyz[1], 2.0f * y_key_only);  // both lights see T = 0.5, Y = 1 each
+}
+
 TEST(RelightSession, UnknownLightNameListsTheFilesLights) {
   const fs::path dir = test::scratch_dir("unknown");
   RelightSession session(write_fixture(dir));

@@ -55,7 +55,10 @@ class RelightSession {
   const std::vector<std::string>& light_names() const { return m_light_names; }
   // The layer's index; throws InputError (input `input`) listing the file's lights when unknown.
   int light_index(std::string_view name, const std::string& input = "--light") const;
-  // Per layer, the default light (file's prizma:lights spectrum, else D65).
+  // Per layer, the default light (file's prizma:lights spectrum, else D65). A recorded spectrum that
+  // cannot be parsed here (a CSV left on the rendering machine) does not stop the file from opening:
+  // its default is an "off" placeholder with the recorded text, and relight() throws InputError
+  // naming the light until the user gives that light a spectrum.
   const std::vector<LightSpec>& default_lights() const { return m_default_lights; }
 
   const RelightSettings& settings() const { return m_settings; }
@@ -88,11 +91,13 @@ class RelightSession {
 
  private:
   void check_pixel(int x, int y, const std::string& input) const;
+  void check_lights_usable() const;
 
   spectral::SpectralImage m_image;
   std::string m_source;
   std::vector<std::string> m_light_names;
   std::vector<LightSpec> m_default_lights;
+  std::vector<std::string> m_default_errors;
   RelightSettings m_settings;
   RelightMatrix m_matrix;
   std::unique_ptr<spectral::DisplayTransform> m_display;
