@@ -9,15 +9,16 @@
 #ifndef PRIZMA_VERSION
 #define PRIZMA_VERSION "0.0.0"
 #endif
-#ifndef PRIZMA_GIT_REVISION
-#define PRIZMA_GIT_REVISION ""
-#endif
-
 namespace prizma::spectral {
+
+namespace detail {
+// Generated at build time by cmake/PrizmaRevision.cmake ("" when unknown).
+const char* git_revision();
+}  // namespace detail
 
 std::string prizma_version() {
   std::string v = PRIZMA_VERSION;
-  const std::string rev = PRIZMA_GIT_REVISION;
+  const std::string rev = detail::git_revision();
   if (!rev.empty()) v += " (git " + rev + ")";
   return v;
 }
