@@ -181,6 +181,12 @@ void bin_cost(benchmark::State& state, const pr::Scene& scene, int n) {
       static_cast<double>(a.counters.collisions) / static_cast<double>(a.paths);
   state.counters["single_collisions_per_path"] =
       static_cast<double>(b.counters.collisions) / static_cast<double>(b.paths);
+  // Ratio tracking toward the lights continues until every lane's transmittance is small, so an
+  // all-bins path takes more shadow steps than a one-wavelength path (its reddest, thinnest bins).
+  state.counters["allbins_shadow_steps_per_path"] =
+      static_cast<double>(a.counters.shadow_steps) / static_cast<double>(a.paths);
+  state.counters["single_shadow_steps_per_path"] =
+      static_cast<double>(b.counters.shadow_steps) / static_cast<double>(b.paths);
 }
 
 // render() on 1 and 2 threads, interleaved: speed-up = t1 / t2.
