@@ -20,7 +20,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -57,6 +59,8 @@ constexpr const char* kAttrSeed = "prizma:seed";
 constexpr const char* kAttrSceneHash = "prizma:sceneHash";
 constexpr const char* kAttrVersion = "prizma:version";
 constexpr const char* kAttrWavelengthSampling = "prizma:wavelengthSampling";
+constexpr const char* kAttrChecksum = "prizma:checksum";
+constexpr const char* kChecksumScheme = "fnv1a64-words:";
 constexpr const char* kVarianceLayer = "var";
 constexpr float kHalfMax = 65504.0f;
 constexpr double kSpeedOfLight_m_per_s = 299792458.0;
@@ -153,11 +157,40 @@ void put_int_or_string(Imf::Header& header, const char* name, std::int64_t v) {
 }
 
 // One channel set to write: a name prefix and a pixel-major, bin-contiguous float buffer.
+enum class LayerKind { Sum, Light, Variance };
+
 struct OutLayer {
   std::string prefix;  // "" / "key." / "var." / "key.var."
   const std::vector<float>* data;
   std::string what;    // for messages
+  LayerKind kind;
 };
+
+// The pixel checksum (prizma:checksum): per light layer and per variance layer, FNV-1a 64 over the
+// values as a reader gets them (float32 bit patterns, one 32-bit word per step), with different
+// offset bases for transport and variance; the per-layer hashes are summed modulo 2⁶⁴ so that the
+// order of the layers does not matter. It covers the pixels, not the header.
+constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
+constexpr std::uint64_t kFnvBasisLight = 0xcbf29ce484222325ULL;
+constexpr std::uint64_t kFnvBasisVariance = 0x84222325cbf29ce4ULL;
+
+template <typename Value>
+std::uint64_t layer_hash(const Value* v, std::size_t n, std::uint64_t basis) {
+  std::uint64_t h = basis;
+  for (std::size_t k = 0; k < n; ++k) {
+    const float f = static_cast<float>(v[k]);
+    std::uint32_t bits;
+    std::memcpy(&bits, &f, sizeof bits);
+    h = (h ^ bits) * kFnvPrime;
+  }
+  return h;
+}
+
+std::string checksum_string(std::uint64_t sum) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(sum));
+  return std::string(kChecksumScheme) + buf;
+}
 
 }  // namespace
 
@@ -219,20 +252,23 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
       sum[k] = static_cast<float>(s);
     }
     check_finite(sum, image.width, bins, "sum of all lights", p);
-    layers.push_back({"", &sum, "sum of all lights"});
-    for (const auto& light : image.lights) layers.push_back({light.name + ".", &light.data, "light \"" + light.name + "\""});
+    layers.push_back({"", &sum, "sum of all lights", LayerKind::Sum});
+    for (const auto& light : image.lights) {
+      layers.push_back({light.name + ".", &light.data, "light \"" + light.name + "\"", LayerKind::Light});
+    }
     if (opts.write_variance) {
       for (const auto& light : image.lights) {
         if (!light.variance.empty()) {
-          layers.push_back({light.name + ".var.", &light.variance, "variance of light \"" + light.name + "\""});
+          layers.push_back({light.name + ".var.", &light.variance, "variance of light \"" + light.name + "\"",
+                            LayerKind::Variance});
         }
       }
     }
   } else {
     const auto& light = image.lights.front();
-    layers.push_back({"", &light.data, "light \"" + light.name + "\""});
+    layers.push_back({"", &light.data, "light \"" + light.name + "\"", LayerKind::Light});
     if (opts.write_variance && !light.variance.empty()) {
-      layers.push_back({"var.", &light.variance, "variance of light \"" + light.name + "\""});
+      layers.push_back({"var.", &light.variance, "variance of light \"" + light.name + "\"", LayerKind::Variance});
     }
   }
 
@@ -266,6 +302,18 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
     if (clamped > 0) {
       std::cerr << "warning: " << p << ": " << clamped << " value" << (clamped == 1 ? "" : "s")
                 << " beyond half's range clamped to 65504\n";
+    }
+  }
+
+  // Checksum of what a reader will get back (half files: the values after conversion to half).
+  std::uint64_t checksum = 0;
+  {
+    auto half_it = half_buffers.begin();
+    for (const auto& layer : layers) {
+      const half* hv = half_out ? (half_it++)->data() : nullptr;
+      if (layer.kind == LayerKind::Sum) continue;
+      const std::uint64_t basis = layer.kind == LayerKind::Light ? kFnvBasisLight : kFnvBasisVariance;
+      checksum += half_out ? layer_hash(hv, expected, basis) : layer_hash(layer.data->data(), expected, basis);
     }
   }
 
@@ -303,6 +351,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   if (!info.wavelength_sampling.empty()) {
     header.insert(kAttrWavelengthSampling, Imf::StringAttribute(info.wavelength_sampling));
   }
+  header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum)));
 
   // Frame buffer: slices point straight into the pixel-major, bin-contiguous buffers (bin i of pixel
   // (x, y) at base + i, x stride = bins values, y stride = width·bins values).
@@ -572,6 +621,22 @@ SpectralImage read_spectral_exr(const fs::path& path) {
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
 
+    // A file written with a checksum must give back exactly what was written: PIZ has no check of
+    // its own, so a damaged but complete file could otherwise read as other, finite values.
+    if (const auto* stored = find_string_attr(header, kAttrChecksum)) {
+      std::uint64_t sum = 0;
+      for (const auto& light : image.lights) {
+        sum += layer_hash(light.data.data(), light.data.size(), kFnvBasisLight);
+        if (!light.variance.empty()) sum += layer_hash(light.variance.data(), light.variance.size(), kFnvBasisVariance);
+      }
+      if (stored->rfind(kChecksumScheme, 0) != 0) {
+        throw InputError(p, std::string(kAttrChecksum) + " \"" + *stored + "\" is not of a known kind (expected " +
+                                kChecksumScheme + "<16 hex digits>)");
+      }
+      if (*stored != checksum_string(sum)) {
+        throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) + " (the file is damaged)");
+      }
+    }
     for (std::size_t k = 0; k < sources.size(); ++k) {
       const std::string what = sources[k].layer.empty() ? "layer T" : "layer \"" + sources[k].layer + "\"";
       check_finite(image.lights[k].data, image.width, n, what, p);

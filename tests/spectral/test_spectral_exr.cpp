@@ -18,6 +18,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <iterator>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -386,6 +388,89 @@ TEST_F(SpectralExr, RefusesTruncatedFile) {
   }
 }
 
+TEST_F(SpectralExr, WritesChecksumOfWhatAReaderGets) {
+  for (const ExrPixelType type : {ExrPixelType::Float, ExrPixelType::Half}) {
+    SpectralImage img = make_image(8, 4, BinLayout::linear(400, 700, 5), {"key", "fill"}, /*variance=*/true);
+    const fs::path p = file(type == ExrPixelType::Half ? "half.exr" : "float.exr");
+    ExrWriteOptions opts;
+    opts.pixel_type = type;
+    opts.write_variance = true;
+    write_spectral_exr(p, img, opts);
+    Imf::InputFile in(p.c_str());
+    const auto* attr = in.header().findTypedAttribute<Imf::StringAttribute>("prizma:checksum");
+    ASSERT_NE(attr, nullptr);
+    EXPECT_EQ(attr->value().rfind("fnv1a64-words:", 0), 0u) << attr->value();
+    EXPECT_EQ(attr->value().size(), std::string("fnv1a64-words:").size() + 16);
+    EXPECT_NO_THROW(read_spectral_exr(p));  // half: the checksum is of the values after conversion
+  }
+}
+
+// PIZ has no check of its own: without the checksum some damaged files read as other finite values.
+// Every single-byte change in the pixel part of the file must either be refused or change nothing.
+TEST_F(SpectralExr, DamagedPixelDataIsNeverReadSilently) {
+  const SpectralImage img = make_image(32, 32, BinLayout::linear(400, 700, 8), {"key", "fill"});
+  const fs::path p = file("good.exr");
+  write_spectral_exr(p, img);
+  std::string bytes;
+  {
+    std::ifstream in(p, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  int refused_by_checksum = 0, refused_otherwise = 0, unchanged = 0;
+  const std::size_t first = bytes.size() / 4;  // the header and offset table are far smaller
+  ASSERT_GT(bytes.size(), 8000u);
+  for (std::size_t at = first; at < bytes.size(); at += 61) {
+    std::string damaged = bytes;
+    damaged[at] = static_cast<char>(damaged[at] ^ 0x10);
+    const fs::path q = file("damaged.exr");
+    {
+      std::ofstream out(q, std::ios::binary | std::ios::trunc);
+      out.write(damaged.data(), static_cast<std::streamsize>(damaged.size()));
+    }
+    try {
+      const SpectralImage back = read_spectral_exr(q);
+      ASSERT_EQ(back.lights.size(), 2u);
+      EXPECT_EQ(back.lights[0].data, img.lights[0].data) << "byte " << at << " changed pixels silently";
+      EXPECT_EQ(back.lights[1].data, img.lights[1].data) << "byte " << at << " changed pixels silently";
+      ++unchanged;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(q.string()), std::string::npos) << what;
+      (what.find("prizma:checksum") != std::string::npos ? refused_by_checksum : refused_otherwise)++;
+    }
+  }
+  // The checksum is what catches most of them (PIZ decodes most damage into other numbers).
+  EXPECT_GT(refused_by_checksum, 0);
+  std::cout << "damaged bytes: " << refused_by_checksum << " refused by the checksum, " << refused_otherwise
+            << " by OpenEXR, " << unchanged << " unchanged\n";
+}
+
+TEST_F(SpectralExr, RefusesUnknownChecksumKind) {
+  const SpectralImage img = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"});
+  const fs::path p = file("sum.exr");
+  write_spectral_exr(p, img);
+  Imf::InputFile in(p.c_str());
+  Imf::Header h = in.header();
+  h.insert("prizma:checksum", Imf::StringAttribute("crc32:1234"));
+  std::vector<float> buf(2 * 2 * 3);
+  Imf::FrameBuffer fb;
+  int c = 0;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it, ++c) {
+    fb.insert(it.name(), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(buf.data() + c), 3 * sizeof(float),
+                                    6 * sizeof(float)));
+  }
+  in.setFrameBuffer(fb);
+  in.readPixels(0, 1);
+  const fs::path out = file("sum-rewritten.exr");
+  {
+    Imf::OutputFile o(out.c_str(), h);
+    o.setFrameBuffer(fb);
+    o.writePixels(2);
+  }
+  const std::string err = read_error(out);
+  EXPECT_NE(err.find("not of a known kind"), std::string::npos) << err;
+}
+
 TEST_F(SpectralExr, RefusesEmissiveOnly) {
   const fs::path p = file("emissive.exr");
   write_plain_exr(p, 2, 2, {"S0.500nm", "S0.600nm"}, {1.0f, 2.0f});
@@ -416,6 +501,7 @@ TEST_F(SpectralExr, RefusesInconsistentEdges) {
     Imf::Header h = in.header();
     h.insert("prizma:binEdgesNm", Imf::FloatVectorAttribute(edges));
     h.erase("prizma:binEdgesNmExact");
+    h.erase("prizma:checksum");  // the pixels below are rewritten
     std::vector<float> buf(2 * 2 * 3);
     Imf::FrameBuffer fb;
     for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
