@@ -89,6 +89,14 @@ if(TARGET prizma-relight)
   prizma_relight_error(edge_count edge_count.exr "6 edges for 4 spectral channels")
   prizma_relight_error(unsorted_edges unsorted_edges.exr "edge|increasing")
   prizma_relight_error(nan_pixel nan_pixel.exr "NaN|nan|finite")
+  prizma_relight_error(bad_checksum bad_checksum.exr "do not match prizma:checksum")
+  prizma_relight_error(unusable_light unusable_light.exr "no_such_lamp\\.csv.*--light key=SPEC")
+  # The same file relights once the unusable light is given a spectrum.
+  add_test(NAME errors.e2e.relight_unusable_light_overridden
+           COMMAND $<TARGET_FILE:prizma-relight> unusable_light.exr --light key=D65 -o relight_unusable_light_ok.png
+           WORKING_DIRECTORY ${_errors_work})
+  set_tests_properties(errors.e2e.relight_unusable_light_overridden PROPERTIES FIXTURES_REQUIRED errors_files
+                       LABELS errors ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
   prizma_relight_error(truncated_existing_output truncated.exr "." EXISTING)
   prizma_relight_error(not_an_exr_existing_exr not_an_exr.exr "EXR|OpenEXR" EXISTING)
   # Light spectra: outside the colour matching range, unsorted CSV.
