@@ -2,13 +2,18 @@
 // against a plain streaming read (a sum) of the same transport buffers, interleaved in the same run.
 // Counters: relight_GBps and sum_GBps (transport bytes read per second) and ratio = relight time /
 // sum time (target ≤ 1.5: the relight is memory-bandwidth bound). Arg: threads (0 = all).
+// Also: the share of a spectral EXR read spent verifying its pixel checksum (BM_ReadVsChecksum).
 #include <benchmark/benchmark.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_reduce.h>
 
+#include <unistd.h>
+
 #include <chrono>
+#include <filesystem>
 #include <memory>
+#include <string>
 #include <random>
 
 #include "prizma/relight/relight_image.h"
@@ -97,6 +102,43 @@ void BM_RelightVsStreamingSum(benchmark::State& state) {
 }
 
 BENCHMARK(BM_RelightVsStreamingSum)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// What verifying prizma:checksum costs when a file is read: read_spectral_exr of a 512×512, 32-bin,
+// two-light float file (its time includes the verification) against spectral_pixel_checksum of the
+// same image alone, interleaved. Counter checksum_share = checksum time / read time.
+void BM_ReadVsChecksum(benchmark::State& state) {
+  const spectral::SpectralImage& full = bench_image();
+  spectral::SpectralImage img;
+  img.width = img.height = kSize / 2;
+  img.bins = full.bins;
+  for (const auto& light : full.lights) {
+    spectral::TransportLayer layer;
+    layer.name = light.name;
+    layer.data.assign(light.data.begin(), light.data.begin() + static_cast<std::ptrdiff_t>(img.pixel_count() * kBins));
+    img.lights.push_back(std::move(layer));
+  }
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("prizma-bench-read-" + std::to_string(::getpid()) + ".exr");
+  spectral::write_spectral_exr(path, img);
+  double read_s = 0.0, sum_s = 0.0;
+  for (auto _ : state) {
+    auto t0 = std::chrono::steady_clock::now();
+    const spectral::SpectralImage back = spectral::read_spectral_exr(path);
+    auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(spectral::spectral_pixel_checksum(back));
+    auto t2 = std::chrono::steady_clock::now();
+    read_s += std::chrono::duration<double>(t1 - t0).count();
+    sum_s += std::chrono::duration<double>(t2 - t1).count();
+    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+  }
+  std::filesystem::remove(path);
+  const double n = static_cast<double>(state.iterations());
+  state.counters["read_ms"] = 1e3 * read_s / n;
+  state.counters["checksum_ms"] = 1e3 * sum_s / n;
+  state.counters["checksum_share"] = sum_s / read_s;
+}
+
+BENCHMARK(BM_ReadVsChecksum)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(3.0);
 
 }  // namespace
 

@@ -14,6 +14,7 @@
 #include <ImfIntAttribute.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 #include <ImfTestFile.h>
 #include <half.h>
 
@@ -67,9 +68,18 @@ constexpr double kSpeedOfLight_m_per_s = 299792458.0;
 
 std::string path_string(const fs::path& p) { return p.string(); }
 
+// Threads for compressing and decompressing chunks. The count given to Imf::InputFile/OutputFile is
+// only how many chunks may be in flight: the work runs on OpenEXR's global thread pool, which has no
+// threads until it is given some, so without setGlobalThreadCount every file was decoded on one core
+// (a 512×512, 32-bin, two-light PIZ file read in 1.35 s).
 int io_threads() {
-  const unsigned hc = std::thread::hardware_concurrency();
-  return static_cast<int>(std::clamp(hc, 1u, 8u));
+  static const int count = [] {
+    const unsigned hc = std::thread::hardware_concurrency();
+    const int n = static_cast<int>(std::clamp(hc, 1u, 8u));
+    if (Imf::globalThreadCount() < n) Imf::setGlobalThreadCount(n);
+    return n;
+  }();
+  return count;
 }
 
 bool valid_light_name(std::string_view name) {
@@ -193,6 +203,15 @@ std::string checksum_string(std::uint64_t sum) {
 }
 
 }  // namespace
+
+std::string spectral_pixel_checksum(const SpectralImage& image) {
+  std::uint64_t sum = 0;
+  for (const auto& light : image.lights) {
+    sum += layer_hash(light.data.data(), light.data.size(), kFnvBasisLight);
+    if (!light.variance.empty()) sum += layer_hash(light.variance.data(), light.variance.size(), kFnvBasisVariance);
+  }
+  return checksum_string(sum);
+}
 
 int SpectralImage::find_light(std::string_view name) const {
   for (std::size_t i = 0; i < lights.size(); ++i) {
@@ -624,16 +643,11 @@ SpectralImage read_spectral_exr(const fs::path& path) {
     // A file written with a checksum must give back exactly what was written: PIZ has no check of
     // its own, so a damaged but complete file could otherwise read as other, finite values.
     if (const auto* stored = find_string_attr(header, kAttrChecksum)) {
-      std::uint64_t sum = 0;
-      for (const auto& light : image.lights) {
-        sum += layer_hash(light.data.data(), light.data.size(), kFnvBasisLight);
-        if (!light.variance.empty()) sum += layer_hash(light.variance.data(), light.variance.size(), kFnvBasisVariance);
-      }
       if (stored->rfind(kChecksumScheme, 0) != 0) {
         throw InputError(p, std::string(kAttrChecksum) + " \"" + *stored + "\" is not of a known kind (expected " +
                                 kChecksumScheme + "<16 hex digits>)");
       }
-      if (*stored != checksum_string(sum)) {
+      if (*stored != spectral_pixel_checksum(image)) {
         throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) + " (the file is damaged)");
       }
     }

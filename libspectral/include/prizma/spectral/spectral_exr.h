@@ -66,6 +66,11 @@ void write_spectral_exr(const std::filesystem::path& path, const SpectralImage& 
 // inconsistent edges and centres.
 SpectralImage read_spectral_exr(const std::filesystem::path& path);
 
+// The prizma:checksum value of an image as held in memory (what read_spectral_exr returns): every
+// light's transport and variance values (docs/spectral-exr.md gives the definition). A file's stored
+// checksum equals this for the image read from it.
+std::string spectral_pixel_checksum(const SpectralImage& image);
+
 // "T.550,000000nm" style channel name for a wavelength (six decimals, comma separator).
 std::string spectral_channel_name(double lambda_nm, std::string_view layer = "");
 
