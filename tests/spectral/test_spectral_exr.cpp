@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <iterator>
 #include <limits>
@@ -106,6 +107,31 @@ void write_plain_exr(const fs::path& p, int w, int h, const std::vector<std::str
   Imf::OutputFile out(p.c_str(), header);
   out.setFrameBuffer(fb);
   out.writePixels(h);
+}
+
+// Copies a float file to `out` with its header changed by `edit`; the pixels are kept as they are.
+fs::path rewrite_header(const fs::path& in_path, const fs::path& out, const std::function<void(Imf::Header&)>& edit) {
+  Imf::InputFile in(in_path.c_str());
+  Imf::Header h = in.header();
+  const Imath::Box2i dw = h.dataWindow();
+  const std::size_t w = static_cast<std::size_t>(dw.max.x - dw.min.x + 1);
+  const std::size_t rows = static_cast<std::size_t>(dw.max.y - dw.min.y + 1);
+  std::size_t channels = 0;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it) ++channels;
+  std::vector<float> buf(w * rows * channels);
+  Imf::FrameBuffer fb;
+  std::size_t c = 0;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it, ++c) {
+    fb.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, buf.data() + c, dw, channels * sizeof(float),
+                                          channels * w * sizeof(float)));
+  }
+  in.setFrameBuffer(fb);
+  in.readPixels(dw.min.y, dw.max.y);
+  edit(h);
+  Imf::OutputFile o(out.c_str(), h);
+  o.setFrameBuffer(fb);
+  o.writePixels(static_cast<int>(rows));
+  return out;
 }
 
 std::string read_error(const fs::path& p) {
@@ -449,24 +475,9 @@ TEST_F(SpectralExr, RefusesUnknownChecksumKind) {
   const SpectralImage img = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"});
   const fs::path p = file("sum.exr");
   write_spectral_exr(p, img);
-  Imf::InputFile in(p.c_str());
-  Imf::Header h = in.header();
-  h.insert("prizma:checksum", Imf::StringAttribute("crc32:1234"));
-  std::vector<float> buf(2 * 2 * 3);
-  Imf::FrameBuffer fb;
-  int c = 0;
-  for (auto it = h.channels().begin(); it != h.channels().end(); ++it, ++c) {
-    fb.insert(it.name(), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(buf.data() + c), 3 * sizeof(float),
-                                    6 * sizeof(float)));
-  }
-  in.setFrameBuffer(fb);
-  in.readPixels(0, 1);
-  const fs::path out = file("sum-rewritten.exr");
-  {
-    Imf::OutputFile o(out.c_str(), h);
-    o.setFrameBuffer(fb);
-    o.writePixels(2);
-  }
+  const fs::path out = rewrite_header(p, file("sum-rewritten.exr"), [](Imf::Header& h) {
+    h.insert("prizma:checksum", Imf::StringAttribute("crc32:1234"));
+  });
   const std::string err = read_error(out);
   EXPECT_NE(err.find("not of a known kind"), std::string::npos) << err;
 }
@@ -497,24 +508,10 @@ TEST_F(SpectralExr, RefusesInconsistentEdges) {
   const fs::path p = file("edges.exr");
   write_spectral_exr(p, img);
   auto rewrite_edges = [&](const std::vector<float>& edges) {
-    Imf::InputFile in(p.c_str());
-    Imf::Header h = in.header();
-    h.insert("prizma:binEdgesNm", Imf::FloatVectorAttribute(edges));
-    h.erase("prizma:binEdgesNmExact");
-    h.erase("prizma:checksum");  // the pixels below are rewritten
-    std::vector<float> buf(2 * 2 * 3);
-    Imf::FrameBuffer fb;
-    for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
-      fb.insert(it.name(), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(buf.data()), 3 * sizeof(float),
-                                      6 * sizeof(float)));
-    }
-    in.setFrameBuffer(fb);
-    in.readPixels(0, 1);
-    const fs::path out = file("edges-rewritten.exr");
-    Imf::OutputFile o(out.c_str(), h);
-    o.setFrameBuffer(fb);
-    o.writePixels(2);
-    return out;
+    return rewrite_header(p, file("edges-rewritten.exr"), [&](Imf::Header& h) {
+      h.insert("prizma:binEdgesNm", Imf::FloatVectorAttribute(edges));
+      h.erase("prizma:binEdgesNmExact");
+    });
   };
   // Wrong count.
   std::string err = read_error(rewrite_edges({400, 500, 600}));
