@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <list>
@@ -415,6 +416,82 @@ struct LayerChannels {
   }
 };
 
+// OpenEXR 3.1 trusts the sizes a header declares: a string or unknown-type attribute of a damaged
+// 800-byte file may declare 1.9 GB, which Imf::Header allocates before it finds the bytes missing
+// (found by fuzz_spectral_exr); a string vector's strings and a preview image's width × height carry
+// their own sizes, allocated the same way. This walks the header(s) first (name, type name, int32
+// size, value; an empty name ends a header; a multi-part file ends its list of headers with an empty
+// one) and refuses any size larger than the bytes that hold it. Anything else malformed is left for
+// OpenEXR to report.
+std::int64_t le_u32(const char* b) {
+  const auto* u = reinterpret_cast<const unsigned char*>(b);
+  return std::int64_t{u[0]} | std::int64_t{u[1]} << 8 | std::int64_t{u[2]} << 16 | std::int64_t{u[3]} << 24;
+}
+std::int64_t le_i32(const char* b) { return static_cast<std::int32_t>(static_cast<std::uint32_t>(le_u32(b))); }
+
+// Empty when the value's inner sizes fit in it, else what is wrong.
+std::string inner_size_problem(const std::string& type, const std::string& value) {
+  const auto n = static_cast<std::int64_t>(value.size());
+  if (type == "stringvector") {
+    for (std::int64_t at = 0; at + 4 <= n;) {
+      const std::int64_t len = le_i32(value.data() + at);
+      if (len < 0 || len > n - at - 4) return "holds a string of " + std::to_string(len) + " bytes";
+      at += 4 + len;
+    }
+  } else if (type == "preview" && n >= 8) {
+    const std::int64_t w = le_u32(value.data()), h = le_u32(value.data() + 4);
+    if (w * h > (n - 8) / 4) return "holds a " + std::to_string(w) + "x" + std::to_string(h) + " preview image";
+  }
+  return {};
+}
+
+void check_header_sizes(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const std::int64_t file_size = static_cast<std::int64_t>(in.tellg());
+  in.seekg(0);
+  char magic_version[8];
+  if (!in.read(magic_version, sizeof magic_version)) return;
+  const bool multipart = (le_u32(magic_version + 4) & 0x1000) != 0;
+  // Reads a null-terminated name; false at end of file or when it is too long to be a name.
+  const auto read_name = [&in](std::string& out) {
+    out.clear();
+    for (char c; in.get(c);) {
+      if (c == '\0') return true;
+      if (out.size() == 255) return false;
+      out.push_back(c);
+    }
+    return false;
+  };
+  std::string name, type, value;
+  while (true) {
+    int attributes = 0;
+    while (read_name(name) && !name.empty()) {
+      ++attributes;
+      char size_bytes[4];
+      if (!read_name(type) || !in.read(size_bytes, sizeof size_bytes)) return;
+      const std::int64_t size = le_i32(size_bytes);
+      const std::int64_t left = file_size - static_cast<std::int64_t>(in.tellg());
+      const auto refuse = [&](const std::string& what) {
+        throw InputError(p, "header attribute \"" + detail::printable(name) + "\" " + what + " (damaged file?)");
+      };
+      if (size < 0 || size > left) {
+        refuse("declares " + std::to_string(size) + " bytes but the file has " + std::to_string(left) + " left");
+      }
+      if (type == "stringvector" || type == "preview") {
+        value.resize(static_cast<std::size_t>(size));
+        if (!in.read(value.data(), size)) return;
+        if (const std::string problem = inner_size_problem(type, value); !problem.empty()) {
+          refuse(problem + " in " + std::to_string(size) + " bytes");
+        }
+      } else {
+        in.seekg(size, std::ios::cur);
+      }
+    }
+    if (!in || !multipart || attributes == 0) return;
+  }
+}
+
 const std::string* find_string_attr(const Imf::Header& h, const char* name) {
   const auto* a = h.findTypedAttribute<Imf::StringAttribute>(name);
   return a ? &a->value() : nullptr;
@@ -459,6 +536,7 @@ SpectralImage read_spectral_exr(const fs::path& path) {
   if (!fs::exists(path, ec)) throw InputError(p, "file does not exist");
   if (fs::is_directory(path, ec)) throw InputError(p, "is a folder, not an OpenEXR file");
   if (!Imf::isOpenExrFile(p.c_str())) throw InputError(p, "not an OpenEXR file");
+  check_header_sizes(p);
 
   try {
     Imf::InputFile file(p.c_str(), io_threads());

@@ -31,6 +31,25 @@ inline std::vector<std::string_view> split(std::string_view s, char sep) {
   }
 }
 
+// Bytes from a file, made safe for a one-line message: control and non-ASCII bytes as \xNN, cut to
+// `max` characters with "..." after.
+inline std::string printable(std::string_view s, std::size_t max = 64) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (const char ch : s.substr(0, max)) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 0x20 && c < 0x7f) {
+      out.push_back(ch);
+    } else {
+      out += "\\x";
+      out.push_back(kHex[c >> 4]);
+      out.push_back(kHex[c & 15]);
+    }
+  }
+  if (s.size() > max) out += "...";
+  return out;
+}
+
 inline std::string to_lower(std::string_view s) {
   std::string out(s);
   for (char& c : out) {

@@ -10,11 +10,14 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfOutputFile.h>
+#include <ImfPreviewImage.h>
 #include <ImfStringAttribute.h>
+#include <ImfStringVectorAttribute.h>
 #include <half.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -411,6 +414,54 @@ TEST_F(SpectralExr, RefusesTruncatedFile) {
     const std::string err = read_error(cut);
     EXPECT_NE(err.find(cut.string()), std::string::npos) << err;
     EXPECT_EQ(err.find("(no InputError)"), std::string::npos) << "kept " << keep << " of " << size;
+  }
+}
+
+// Damaged headers whose sizes claim far more bytes than the file has: refused before OpenEXR
+// allocates what they claim (it trusts them), with a message naming the attribute. A string attribute
+// declaring ~1.9 GB (and the same as an attribute type OpenEXR does not know, read as opaque bytes),
+// a string vector holding a 1 GB string, and a 60000 × 2 preview image in 24 bytes.
+TEST_F(SpectralExr, RefusesHeaderSizesLargerThanTheFile) {
+  const SpectralImage img = make_image(4, 4, BinLayout::linear(400, 700, 3), {"a"});
+  const fs::path plain = file("plain.exr");
+  write_spectral_exr(plain, img);
+  const fs::path extra = rewrite_header(plain, file("extra.exr"), [](Imf::Header& h) {
+    h.insert("notes", Imf::StringVectorAttribute({"abc", "de"}));
+    h.setPreviewImage(Imf::PreviewImage(2, 2));
+  });
+  std::ifstream in(extra, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_NO_THROW(read_spectral_exr(extra));
+
+  struct Damage {
+    std::string key;      // attribute name and type name, each with its terminating NUL
+    std::size_t offset;   // of the patched int32, after the key (0 = the attribute's own size)
+    std::uint32_t value;  // written little-endian, as the file is
+    std::string expect;
+    std::string new_type;  // when not empty: the type name replaced by this (same length)
+  };
+  const auto nul = std::string(1, '\0');
+  const std::string version = "prizma:version" + nul + "string" + nul;
+  const std::vector<Damage> cases = {
+      {version, 0, 1929405800u, "header attribute \"prizma:version\" declares 1929405800 bytes", ""},
+      {version, 0, 1929405800u, "header attribute \"prizma:version\" declares 1929405800 bytes", "strinX"},
+      {"notes" + nul + "stringvector" + nul, 4, 1000000000u,
+       "header attribute \"notes\" holds a string of 1000000000 bytes in 13 bytes", ""},
+      {"preview" + nul + "preview" + nul, 4, 60000u, "header attribute \"preview\" holds a 60000x2 preview", ""},
+  };
+  int k = 0;
+  for (const Damage& d : cases) {
+    const auto at = bytes.find(d.key);
+    ASSERT_NE(at, std::string::npos) << d.key;
+    std::string damaged = bytes;
+    if (!d.new_type.empty()) damaged.replace(at + d.key.size() - d.new_type.size() - 1, d.new_type.size(), d.new_type);
+    const std::uint32_t v = d.value;
+    std::memcpy(&damaged[at + d.key.size() + d.offset], &v, sizeof v);
+    const fs::path out = file("damaged-" + std::to_string(k++) + ".exr");
+    std::ofstream(out, std::ios::binary) << damaged;
+    const std::string err = read_error(out);
+    EXPECT_NE(err.find(out.string()), std::string::npos) << err;
+    EXPECT_NE(err.find(d.expect), std::string::npos) << err;
   }
 }
 
