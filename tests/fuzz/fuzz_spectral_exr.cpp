@@ -3,7 +3,8 @@
 // kMaxPixels pixels are skipped: a 500-byte file may declare 6697591×9 pixels, and reading it
 // legitimately allocates and zero-fills ~700 MB before OpenEXR finds the data missing (20–40 s
 // under ASan), which would only slow the fuzzer down. Attributes declaring more bytes than the file
-// holds are not skipped: the reader itself refuses them (docs/errors.md).
+// holds, or whose content disagrees with their size, are not skipped: the reader itself refuses
+// them (docs/errors.md).
 // InputError is the expected answer to a bad file; any other exception, a crash, undefined
 // behaviour or an image that breaks the SpectralImage invariants is a bug.
 #include <cmath>

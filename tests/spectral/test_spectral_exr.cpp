@@ -137,6 +137,13 @@ fs::path rewrite_header(const fs::path& in_path, const fs::path& out, const std:
   return out;
 }
 
+// The little-endian int32 at `at` in `bytes`.
+std::int64_t le_u32_at(const std::string& bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  std::memcpy(&v, bytes.data() + at, sizeof v);
+  return v;
+}
+
 std::string read_error(const fs::path& p) {
   try {
     read_spectral_exr(p);
@@ -417,11 +424,12 @@ TEST_F(SpectralExr, RefusesTruncatedFile) {
   }
 }
 
-// Damaged headers whose sizes claim far more bytes than the file has: refused before OpenEXR
-// allocates what they claim (it trusts them), with a message naming the attribute. A string attribute
-// declaring ~1.9 GB (and the same as an attribute type OpenEXR does not know, read as opaque bytes),
-// a string vector holding a 1 GB string, and a 60000 × 2 preview image in 24 bytes.
-TEST_F(SpectralExr, RefusesHeaderSizesLargerThanTheFile) {
+// Damaged headers: refused before OpenEXR allocates what they claim (it trusts the sizes) or reads
+// the rest of the header out of step, with a message naming the attribute. A string attribute
+// declaring ~1.9 GB (also as a type OpenEXR does not know, read as opaque bytes), a string vector
+// holding a 1 GB string, a 60000 × 2 preview image in 24 bytes, a channel list whose size is one byte
+// more than its content, and a data window (box2i) declared with 17 bytes.
+TEST_F(SpectralExr, RefusesHeaderSizesThatDisagreeWithTheFile) {
   const SpectralImage img = make_image(4, 4, BinLayout::linear(400, 700, 3), {"a"});
   const fs::path plain = file("plain.exr");
   write_spectral_exr(plain, img);
@@ -434,20 +442,25 @@ TEST_F(SpectralExr, RefusesHeaderSizesLargerThanTheFile) {
   ASSERT_NO_THROW(read_spectral_exr(extra));
 
   struct Damage {
-    std::string key;      // attribute name and type name, each with its terminating NUL
-    std::size_t offset;   // of the patched int32, after the key (0 = the attribute's own size)
-    std::uint32_t value;  // written little-endian, as the file is
-    std::string expect;
+    std::string key;       // attribute name and type name, each with its terminating NUL
+    std::size_t offset;    // of the patched int32 after the key (0: the attribute's own size)
+    std::uint32_t value;   // written little-endian, as the file is
     std::string new_type;  // when not empty: the type name replaced by this (same length)
+    std::string expect;
   };
   const auto nul = std::string(1, '\0');
   const std::string version = "prizma:version" + nul + "string" + nul;
+  const std::string channels = "channels" + nul + "chlist" + nul;
+  const auto chlist_size = static_cast<std::uint32_t>(le_u32_at(bytes, bytes.find(channels) + channels.size()));
   const std::vector<Damage> cases = {
-      {version, 0, 1929405800u, "header attribute \"prizma:version\" declares 1929405800 bytes", ""},
-      {version, 0, 1929405800u, "header attribute \"prizma:version\" declares 1929405800 bytes", "strinX"},
-      {"notes" + nul + "stringvector" + nul, 4, 1000000000u,
-       "header attribute \"notes\" holds a string of 1000000000 bytes in 13 bytes", ""},
-      {"preview" + nul + "preview" + nul, 4, 60000u, "header attribute \"preview\" holds a 60000x2 preview", ""},
+      {version, 0, 1929405800u, "", "\"prizma:version\" (string, 1929405800 bytes) is larger than the"},
+      {version, 0, 1929405800u, "strinX", "\"prizma:version\" (strinX, 1929405800 bytes) is larger than the"},
+      {"notes" + nul + "stringvector" + nul, 4, 1000000000u, "",
+       "\"notes\" (stringvector, 13 bytes) holds a string of 1000000000 bytes"},
+      {"preview" + nul + "preview" + nul, 4, 60000u, "", "\"preview\" (preview, 24 bytes) holds a 60000x2 preview"},
+      {channels, 0, chlist_size + 1, "",
+       "\"channels\" (chlist, " + std::to_string(chlist_size + 1) + " bytes) is a channel list that ends before"},
+      {"dataWindow" + nul + "box2i" + nul, 0, 17u, "", "\"dataWindow\" (box2i, 17 bytes) should have 16 bytes"},
   };
   int k = 0;
   for (const Damage& d : cases) {
@@ -460,7 +473,7 @@ TEST_F(SpectralExr, RefusesHeaderSizesLargerThanTheFile) {
     const fs::path out = file("damaged-" + std::to_string(k++) + ".exr");
     std::ofstream(out, std::ios::binary) << damaged;
     const std::string err = read_error(out);
-    EXPECT_NE(err.find(out.string()), std::string::npos) << err;
+    EXPECT_NE(err.find(out.string() + ": header attribute "), std::string::npos) << err;
     EXPECT_NE(err.find(d.expect), std::string::npos) << err;
   }
 }
