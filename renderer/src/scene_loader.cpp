@@ -487,6 +487,21 @@ void read_settings(const Reader& rd, const json& root, RenderSettings& s) {
   }
 }
 
+// "line L, column C" of byte `offset` of `text` (both counted from 1).
+std::string line_column(const std::string& text, std::size_t offset) {
+  std::size_t line = 1;
+  std::size_t col = 1;
+  for (std::size_t i = 0; i < std::min(offset, text.size()); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(col);
+}
+
 // Parses JSON, rejecting duplicate keys, reporting line and column of syntax errors.
 json parse_json(const std::string& text, const std::string& file) {
   std::vector<std::set<std::string>> keys;
@@ -504,22 +519,19 @@ json parse_json(const std::string& text, const std::string& file) {
     if (!duplicate.empty()) throw InputError(file, "duplicate key \"" + duplicate + "\"");
     return j;
   } catch (const json::parse_error& e) {
-    // Line and column of the offending byte.
-    std::size_t line = 1;
-    std::size_t col = 1;
-    const std::size_t end = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
-    for (std::size_t i = 0; i < end; ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
     std::string what = e.what();
     const std::size_t colon = what.find(": ", what.find("parse error"));
     if (colon != std::string::npos) what = what.substr(colon + 2);
-    throw InputError(file, "malformed JSON at line " + std::to_string(line) + ", column " + std::to_string(col) + ": " + what);
+    throw InputError(file, "malformed JSON at " + line_column(text, e.byte > 0 ? e.byte - 1 : 0) + ": " + what);
+  } catch (const json::out_of_range& e) {
+    // A number beyond the range of a double (1e400): nlohmann reports the number, not where it is.
+    const std::string what = e.what();
+    const std::size_t open = what.find('\''), close = what.rfind('\'');
+    const std::string number = open < close ? what.substr(open + 1, close - open - 1) : std::string();
+    const std::size_t at = number.empty() ? std::string::npos : text.find(number);
+    const std::string where = at == std::string::npos ? std::string() : " at " + line_column(text, at);
+    const std::string shown = number.size() > 24 ? number.substr(0, 24) + "..." : number;
+    throw InputError(file, "number " + shown + where + " is beyond the range of a double");
   }
 }
 

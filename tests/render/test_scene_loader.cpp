@@ -230,6 +230,27 @@ TEST(SceneLoaderErrors, DuplicateKeys) {
   }
 }
 
+// A number beyond the range of a double makes nlohmann::json throw out_of_range, not parse_error:
+// found by fuzz_scene (a 300-digit number); it must still be an InputError naming where it is.
+TEST(SceneLoaderErrors, NumberBeyondDouble) {
+  ScratchDir dir;
+  const auto path = dir.write("huge.json", "{\n  \"samples\": 4,\n  \"seed\": 1e400\n}");
+  try {
+    load_scene(path);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.reason(), "number 1e400 at line 3, column 11 is beyond the range of a double") << e.what();
+  }
+  const auto digits = dir.write("digits.json", "{\"samples\": " + std::string(400, '9') + "}");
+  try {
+    load_scene(digits);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.reason(), "number " + std::string(24, '9') + "... at line 1, column 13 is beyond the range of a double")
+        << e.what();
+  }
+}
+
 TEST(SceneLoaderErrors, WrongTypes) {
   ScratchDir dir;
   json j = base_scene();
