@@ -57,6 +57,17 @@ void expect_error(const ScratchDir& dir, const json& j, const std::string& field
   }
 }
 
+// The InputError that loading `path` throws; a test failure (and an empty error) when none is thrown.
+InputError load_error(const std::filesystem::path& path) {
+  try {
+    load_scene(path);
+  } catch (const InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << path << ": no InputError";
+  return InputError("", "");
+}
+
 TEST(SceneLoader, HappyPathFillsEveryField) {
   ScratchDir dir;
   const auto path = write_scene(dir, base_scene());
@@ -189,13 +200,9 @@ TEST(SceneLoader, HashIsStableAndFollowsTheText) {
 TEST(SceneLoaderErrors, MalformedJsonReportsLineAndColumn) {
   ScratchDir dir;
   const auto path = dir.write("bad.json", "{\n  \"samples\": 4,\n  \"seed\" 3\n}\n");
-  try {
-    load_scene(path);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.input(), path.string());
-    EXPECT_NE(e.reason().find("line 3, column"), std::string::npos) << e.what();
-  }
+  const InputError e = load_error(path);
+  EXPECT_EQ(e.input(), path.string());
+  EXPECT_NE(e.reason().find("line 3, column"), std::string::npos) << e.what();
 }
 
 TEST(SceneLoaderErrors, MissingFile) {
@@ -221,34 +228,19 @@ TEST(SceneLoaderErrors, UnknownFields) {
 
 TEST(SceneLoaderErrors, DuplicateKeys) {
   ScratchDir dir;
-  const auto path = dir.write("dup.json", R"({"samples": 4, "samples": 5})");
-  try {
-    load_scene(path);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(e.reason().find("duplicate key \"samples\""), std::string::npos) << e.what();
-  }
+  const InputError e = load_error(dir.write("dup.json", R"({"samples": 4, "samples": 5})"));
+  EXPECT_NE(e.reason().find("duplicate key \"samples\""), std::string::npos) << e.what();
 }
 
 // A number beyond the range of a double makes nlohmann::json throw out_of_range, not parse_error:
 // found by fuzz_scene (a 300-digit number); it must still be an InputError naming where it is.
 TEST(SceneLoaderErrors, NumberBeyondDouble) {
   ScratchDir dir;
-  const auto path = dir.write("huge.json", "{\n  \"samples\": 4,\n  \"seed\": 1e400\n}");
-  try {
-    load_scene(path);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.reason(), "number 1e400 at line 3, column 11 is beyond the range of a double") << e.what();
-  }
+  const auto huge = dir.write("huge.json", "{\n  \"samples\": 4,\n  \"seed\": 1e400\n}");
+  EXPECT_EQ(load_error(huge).reason(), "number 1e400 at line 3, column 11 is beyond the range of a double");
   const auto digits = dir.write("digits.json", "{\"samples\": " + std::string(400, '9') + "}");
-  try {
-    load_scene(digits);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.reason(), "number " + std::string(24, '9') + "... at line 1, column 13 is beyond the range of a double")
-        << e.what();
-  }
+  EXPECT_EQ(load_error(digits).reason(),
+            "number " + std::string(24, '9') + "... at line 1, column 13 is beyond the range of a double");
 }
 
 TEST(SceneLoaderErrors, WrongTypes) {
