@@ -92,15 +92,10 @@ Eigen::Vector3d ColorMatching::integrate(const Spectrum& s) const {
 
 Eigen::Matrix<double, 3, Eigen::Dynamic> relight_weights(const ColorMatching& cmf, const Spectrum& light,
                                                           const BinLayout& bins, LightUnits units) {
-  if (bins.min_nm() < cmf.lo_nm() || bins.max_nm() > cmf.hi_nm()) {
-    throw InputError("light", "bins " + format_double(bins.min_nm()) + "–" + format_double(bins.max_nm()) +
-                                  " nm extend outside the " + observer_name(cmf.observer()) +
-                                  " colour matching table (" + format_double(cmf.lo_nm()) + "–" +
-                                  format_double(cmf.hi_nm()) + " nm)");
-  }
   const int n = bins.size();
   Eigen::Matrix<double, 3, Eigen::Dynamic> m(3, n);
-  // Exact ∫_{bin} E·cmf_c dλ of the two piecewise-linear tables (never bin averages multiplied).
+  // Exact ∫_{bin} E·cmf_c dλ of the two piecewise-linear tables (never bin averages multiplied);
+  // both are zero outside their tables, so a bin reaching past the CMF table weighs only its inside.
   for (int i = 0; i < n; ++i) {
     for (int c = 0; c < 3; ++c) m(c, i) = cmf.channel(c).integrate_product(light, bins.lo_nm(i), bins.hi_nm(i));
   }
@@ -111,6 +106,13 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> relight_weights(const ColorMatching& cm
   }
   if (units == LightUnits::RelativeToWhite) m /= y_total;
   return m;
+}
+
+std::string cmf_coverage_note(const ColorMatching& cmf, const BinLayout& bins) {
+  if (bins.min_nm() >= cmf.lo_nm() && bins.max_nm() <= cmf.hi_nm()) return "";
+  return "bins " + format_double(bins.min_nm()) + "–" + format_double(bins.max_nm()) + " nm reach outside the " +
+         observer_name(cmf.observer()) + " colour matching table (" + format_double(cmf.lo_nm()) + "–" +
+         format_double(cmf.hi_nm()) + " nm); the functions are taken as zero there";
 }
 
 }  // namespace prizma::spectral

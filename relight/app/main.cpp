@@ -58,6 +58,16 @@ const char* cmf_table(spectral::Observer obs) {
 // The command line's settings on top of the file's default lights.
 relight::RelightSettings settings_from(const CliOptions& o, const relight::RelightSession& session) {
   relight::RelightSettings s = session.settings();
+  // Each layer is set once: a repeated --light NAME=…, or SPEC for all layers given twice, is refused.
+  std::vector<std::string> seen;
+  for (const std::string& arg : o.lights) {
+    const std::string target = arg.find('=') == std::string::npos ? std::string("*") : arg.substr(0, arg.find('='));
+    if (std::find(seen.begin(), seen.end(), target) != seen.end()) {
+      throw InputError("--light", target == "*" ? "a light for every layer is given twice"
+                                                : "light \"" + target + "\" is given twice");
+    }
+    seen.push_back(target);
+  }
   for (const std::string& arg : o.lights) {
     const auto eq = arg.find('=');
     if (eq == std::string::npos) {
@@ -107,6 +117,9 @@ int run(const CliOptions& o) {
               << (spectral::data_dir() / cmf_table(s.relight.cmf)).string() << ")\n"
               << "prizma-relight: OCIO config " << session.display().config_path().string() << ", "
               << session.display().description() << "\n";
+    const std::string coverage =
+        spectral::cmf_coverage_note(spectral::ColorMatching::get(s.relight.cmf), session.image().bins);
+    if (!coverage.empty()) std::cerr << "prizma-relight: note: " << coverage << "\n";
     std::istringstream lights(session.describe_lights());
     for (std::string line; std::getline(lights, line);) std::cerr << "prizma-relight: light " << line << "\n";
   }
@@ -145,7 +158,8 @@ int main(int argc, char** argv) {
   app.add_option("-o,--output", o.output, "output image: .png (8/16-bit), .tif, .exr (linear XYZ or --colour-space)");
   app.add_option("--light", o.lights,
                  "NAME=SPEC for one light layer, or SPEC for every layer; SPEC: D65, A, F11, LED-B1, "
-                 "blackbody:3200K, gaussian:550:20, box:500:560, csv:FILE, off, …*SCALE (repeatable)");
+                 "blackbody:3200K, gaussian:550:20, box:500:560, csv:FILE, off, …*SCALE (repeatable)")
+      ->allow_extra_args(false);  // one value per --light: `--light D65 in.exr` leaves in.exr the input
   app.add_option("--exposure", o.exposure_ev, "exposure in stops (EV)");
   app.add_option("--cmf", o.cmf, "colour matching functions: 1931, 1964, 2012-2, 2012-10")->capture_default_str();
   app.add_flag("--adapt", o.adapt, "Bradford chromatic adaptation from the light mix's white to D65");

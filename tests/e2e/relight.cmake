@@ -33,6 +33,11 @@ prizma_relight_e2e(png16_adapt "scene.exr|--light|A|--adapt|--bit-depth|16|-o|si
 prizma_relight_e2e(tiff "scene.exr|--cmf|2012-10|-o|single.tif" MUST_EXIST single.tif)
 prizma_relight_e2e(exr_xyz "scene.exr|--light|back=gaussian:550:5*2|-o|single.exr" MUST_EXIST single.exr)
 prizma_relight_e2e(show "scene.exr|--show" OUT_REGEX "▀")
+# One value per --light: a file after it is the input, not a second spectrum (issue 15).
+prizma_relight_e2e(light_before_input "--light|D65|scene.exr|-o|light_first.png" MUST_EXIST light_first.png)
+# The 2012 observers on the default 380–780 nm bins (their table starts at 390 nm): zero below it.
+prizma_relight_e2e(cmf2012_below_table "colorchecker.exr|--cmf|2012-2|--verbose|-o|cmf2012.png" MUST_EXIST cmf2012.png
+  STDERR_MATCH "note: bins .* reach outside the cie2012-2 colour matching table \\(390–830 nm\\)")
 prizma_relight_e2e(batch "scene.exr|--batch|batch.json" MUST_EXIST "batch_d65.png|batch_a16.png|batch_xyz.exr")
 prizma_relight_e2e(interactive "scene.exr|-i|--preview|session_preview.png"
   STDIN ${PRIZMA_E2E_DIR}/relight/session.txt
@@ -53,4 +58,6 @@ prizma_relight_e2e(err_bad_cmf "scene.exr|--cmf|1955|-o|err8.png" EXPECT_RC 2 ER
 prizma_relight_e2e(err_bad_display "scene.exr|--display|NoSuchDisplay|-o|err9.png" EXPECT_RC 2 ERR_REGEX "NoSuchDisplay" MUST_NOT_EXIST err9.png)
 prizma_relight_e2e(err_existing_output_survives "scene.exr|--light|key=nope|-o|existing.png" EXPECT_RC 2
   ERR_REGEX "nope" KEEP_FILE existing.png KEEP_CONTENT "keep me")
+prizma_relight_e2e(err_light_twice "scene.exr|--light|key=D65|--light|key=A|-o|err10.png" EXPECT_RC 2
+  ERR_REGEX "--light: light \"key\" is given twice" MUST_NOT_EXIST err10.png)
 prizma_relight_e2e(err_bad_batch "scene.exr|--batch|fake.exr" EXPECT_RC 2 ERR_REGEX "fake\\.exr: not valid JSON")

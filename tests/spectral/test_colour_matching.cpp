@@ -168,17 +168,23 @@ TEST(ColorMatching, RelativeNormalisation) {
   EXPECT_NEAR((rel2 - rel).norm(), 0.0, 1e-12);
 }
 
-TEST(ColorMatching, RejectsBinsOutsideTableAndDarkLights) {
-  // Default bins start at 380 nm; the 2012 tables start at 390 nm.
-  try {
-    (void)relight_weights(ColorMatching::get(Observer::Cie2012_2deg), parse_spectrum("D65"), BinLayout());
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.input(), "light");
-    EXPECT_NE(std::string(e.what()).find("390"), std::string::npos) << e.what();
-  }
-  EXPECT_NO_THROW((void)relight_weights(ColorMatching::get(Observer::Cie2012_2deg), parse_spectrum("D65"),
-                                        BinLayout::linear(390, 780, 10)));
+TEST(ColorMatching, BinsOutsideTheTableWeighOnlyTheirInside) {
+  // Default bins start at 380 nm; the 2012 tables start at 390 nm. Outside its table a CMF is zero, so
+  // the first bin [380, 390+) weighs only its part above 390 nm and the white's Y is what the table
+  // gives: the weights over 380–780 equal those over 390–780 with the first bins' inside parts.
+  const auto& cmf = ColorMatching::get(Observer::Cie2012_2deg);
+  const Spectrum d65 = parse_spectrum("D65");
+  const auto w = relight_weights(cmf, d65, BinLayout::from_edges({380, 390, 400, 780}), LightUnits::Absolute);
+  const auto inside = relight_weights(cmf, d65, BinLayout::from_edges({390, 400, 780}), LightUnits::Absolute);
+  EXPECT_EQ(w.col(0).norm(), 0.0);  // [380, 390] lies wholly below the table
+  EXPECT_NEAR((w.rightCols(2) - inside).norm(), 0.0, 1e-12 * inside.norm());
+  EXPECT_NO_THROW((void)relight_weights(cmf, d65, BinLayout()));
+  EXPECT_NE(cmf_coverage_note(cmf, BinLayout()).find("390"), std::string::npos);
+  EXPECT_EQ(cmf_coverage_note(cmf, BinLayout::linear(390, 780, 10)), "");
+  EXPECT_EQ(cmf_coverage_note(cie1931(), BinLayout()), "");
+}
+
+TEST(ColorMatching, RejectsDarkLights) {
   // No energy inside the bins.
   try {
     (void)relight_weights(cie1931(), parse_spectrum("box:790:820"), BinLayout());

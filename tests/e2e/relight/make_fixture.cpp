@@ -5,6 +5,7 @@
 //   rgb.exr        a plain RGB EXR (no spectral channels)
 //   fake.exr       a text file with an .exr name
 //   existing.png   a file a failing run must leave untouched ("keep me")
+//   colorchecker.exr  the image below (bins from 380 nm, below the CIE 2012 tables)
 // With "--colorchecker FILE.exr" it writes instead the image of docs/relight.md: the 24 ColorChecker
 // patches (reflectance bin averages, 32 bins over 380–700 nm), lit by "key" from the left and "back"
 // from the right.
@@ -104,6 +105,7 @@ int main(int argc, char** argv) {
 })";
   std::ofstream(dir / "fake.exr") << "not an EXR file\n";
   std::ofstream(dir / "existing.png") << "keep me";
+  if (const int rc = write_colorchecker((dir / "colorchecker.exr").string()); rc != 0) return rc;
 
   const float rgb[3 * 4] = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f, 1.0f, 0.5f, 0.0f};
   auto out = OIIO::ImageOutput::create((dir / "rgb.exr").string());

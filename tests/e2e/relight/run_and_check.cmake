@@ -2,6 +2,7 @@
 #   EXE, ARGS ("|"-separated), WORKDIR, EXPECT_RC (default 0), STDIN (file fed to stdin)
 #   ERR_REGEX          stderr must be exactly one line matching it (error cases)
 #   OUT_REGEX          "|"-separated regexes stdout must each match
+#   STDERR_MATCH       a regex stderr must match somewhere (any number of lines)
 #   MUST_EXIST, MUST_NOT_EXIST  "|"-separated files (relative to WORKDIR)
 #   KEEP_FILE, KEEP_CONTENT     a file whose content must be unchanged
 string(REPLACE "|" ";" args "${ARGS}")
@@ -31,6 +32,9 @@ if(DEFINED ERR_REGEX)
   if(NOT err MATCHES "${ERR_REGEX}")
     message(FATAL_ERROR "stderr does not match '${ERR_REGEX}'")
   endif()
+endif()
+if(DEFINED STDERR_MATCH AND NOT err MATCHES "${STDERR_MATCH}")
+  message(FATAL_ERROR "stderr does not match '${STDERR_MATCH}'")
 endif()
 if(DEFINED OUT_REGEX)
   string(REPLACE "|" ";" regexes "${OUT_REGEX}")

@@ -45,10 +45,14 @@ enum class LightUnits {
 
 // The 3×n relight matrix M[c][i] = k·∫_{bin i} E(λ)·cmf_c(λ) dλ, integrated exactly from the
 // tables (never a product of bin averages). With RelativeToWhite, k = 1/∫_{bins} E·ȳ dλ so that
-// Σ_i M[1][i] = 1. Throws InputError (input "light") when bins lie outside the table or the light
-// has no energy where ȳ > 0 inside the bins.
+// Σ_i M[1][i] = 1. The colour matching functions are zero outside their table (the CIE 2012 tables
+// start at 390 nm; below it their contribution is under 1e-4 of Y), so any bins are accepted.
+// Throws InputError (input "light") when the light has no energy where ȳ > 0 inside the bins.
 Eigen::Matrix<double, 3, Eigen::Dynamic> relight_weights(const ColorMatching& cmf, const Spectrum& light,
                                                           const BinLayout& bins,
                                                           LightUnits units = LightUnits::RelativeToWhite);
+
+// A one-line note when `bins` reach outside the table of `cmf` (those parts weigh nothing), else "".
+std::string cmf_coverage_note(const ColorMatching& cmf, const BinLayout& bins);
 
 }  // namespace prizma::spectral
