@@ -73,10 +73,13 @@ class EditLineReader final : public LineReader {
     history(m_history, &ev, H_SETUNIQUE, 1);
     if (!m_opts.history_file.empty()) {
       std::error_code ec;
-      if (fs::exists(m_opts.history_file, ec) && history(m_history, &ev, H_LOAD, m_opts.history_file.c_str()) < 0 &&
-          m_opts.warnings) {
-        *m_opts.warnings << m_opts.program << ": warning: " << m_opts.history_file.string()
-                         << ": history not loaded (not readable or not a libedit history file)\n";
+      if (fs::exists(m_opts.history_file, ec) && history(m_history, &ev, H_LOAD, m_opts.history_file.c_str()) < 0) {
+        // Not ours to overwrite: this session keeps its history to itself.
+        m_history_failed = true;
+        if (m_opts.warnings) {
+          *m_opts.warnings << m_opts.program << ": warning: " << m_opts.history_file.string()
+                           << ": history not loaded (not readable or not a libedit history file), and not saved\n";
+        }
       }
     }
     m_el = el_init(m_opts.program.c_str(), m_opts.in, m_opts.out, stderr);

@@ -3,7 +3,7 @@
 keys go in with send-keys, the screen comes back with capture-pane. Checks line editing (Up recalls
 the last command), Tab completion (a light name; a display name with a blank, quoted), history kept
 across sessions in $XDG_STATE_HOME/prizma/relight_history, status, adapt, undo, show, the pixel-index
-errors, and that a history that cannot be written is only a warning.
+errors, and that a history that cannot be written, or is not libedit's, is only a warning.
 
 Every wait polls the screen until the expected text is there, with a bound (TIMEOUT_S); the tmux
 server is killed at the end whatever happened.
@@ -215,6 +215,22 @@ def main():
         pane.type("quit")
         pane.key("Enter")
         pane.wait("the third session to end", lambda s: "[exited 0]" in s)
+
+        # Session 4: a history file that is not libedit's is neither read nor overwritten.
+        foreign_state = os.path.join(work, "foreign")
+        os.makedirs(os.path.join(foreign_state, "prizma"))
+        foreign = os.path.join(foreign_state, "prizma", "relight_history")
+        with open(foreign, "w") as f:
+            f.write("my own notes\n")
+        pane.start(session_command(exe, scene, dict(env, XDG_STATE_HOME=foreign_state)))
+        screen = pane.wait_prompt(1)
+        expect("history not loaded" in screen, "no warning for a foreign history file", screen)
+        pane.command("exposure 1")
+        pane.type("quit")
+        pane.key("Enter")
+        pane.wait("the fourth session to end", lambda s: "[exited 0]" in s)
+        with open(foreign) as f:
+            expect(f.read() == "my own notes\n", "the foreign history file was overwritten")
         print("terminal session test passed")
         return 0
     except Failure as e:
