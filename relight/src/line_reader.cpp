@@ -88,7 +88,9 @@ class EditLineReader final : public LineReader {
     el_set(m_el, EL_SIGNAL, 1);  // restore the terminal on signals and follow window size changes
     el_set(m_el, EL_PROMPT, &EditLineReader::prompt);
     el_set(m_el, EL_HIST, history, m_history);
-    el_set(m_el, EL_ADDFN, "prizma-complete", "complete the word at the cursor", &EditLineReader::complete);
+    // The wide call: libedit keeps these (static) strings as they are, where the narrow el_set copies
+    // them and never frees the copies.
+    el_wset(m_el, EL_ADDFN, L"prizma-complete", L"complete the word at the cursor", &EditLineReader::complete);
     el_set(m_el, EL_BIND, "^I", "prizma-complete", nullptr);
     el_source(m_el, nullptr);  // the user's ~/.editrc, as every libedit program reads it
   }
