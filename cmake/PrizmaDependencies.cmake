@@ -13,6 +13,9 @@ find_package(nlohmann_json CONFIG REQUIRED)
 pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
 # OpenColorIO's config sits where find_package does not look: use pkg-config.
 pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO)
+# prizma-relight -i: line editing and history (libedit-dev), inline images in sixel terminals (libsixel-dev).
+pkg_check_modules(LIBEDIT REQUIRED IMPORTED_TARGET libedit)
+pkg_check_modules(SIXEL REQUIRED IMPORTED_TARGET libsixel)
 
 # libnifti's CMake config points at a non-multiarch path: find the pieces by hand.
 find_package(ZLIB REQUIRED)

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <clocale>
 #include <cmath>
 #include <sstream>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include "prizma/relight/interactive_shell.h"
 #include "prizma/relight/output_image.h"
 #include "prizma/relight/relight_session.h"
+#include "prizma/relight/terminal_image.h"
 #include "prizma/relight/terminal_preview.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/colour_matching.h"
@@ -42,6 +44,7 @@ struct CliOptions {
   bool interactive = false;
   std::string preview;
   bool show = false;
+  bool show_every = false;
   bool verbose = false;
 };
 
@@ -96,6 +99,7 @@ int run(const CliOptions& o) {
   if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show) {
     throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i or --show");
   }
+  if (o.show_every && !o.interactive) throw InputError("--show-every", "only with -i/--interactive");
   if (!o.preview.empty() && !o.interactive) throw InputError("--preview", "only with -i/--interactive");
   // Cheap checks first: nothing is loaded when the output cannot be written.
   if (!o.output.empty()) relight::check_output_path(o.output, "--output");
@@ -136,14 +140,22 @@ int run(const CliOptions& o) {
   }
   if (o.show && !o.interactive) {
     const relight::XyzImage& img = session.xyz();
-    relight::print_terminal_thumbnail(std::cout, relight::to_display(img, session.display()), img.width, img.height);
+    const std::vector<float> rgb = relight::to_display(img, session.display());
+    if (::isatty(STDOUT_FILENO)) {  // sixel, kitty or half blocks, sized to the window
+      relight::draw_terminal_image(std::cout, rgb, img.width, img.height,
+                                   relight::detect_image_protocol(STDIN_FILENO, STDOUT_FILENO),
+                                   relight::terminal_size(STDOUT_FILENO), 1);
+    } else {
+      relight::print_terminal_thumbnail(std::cout, rgb, img.width, img.height);
+    }
   }
   if (o.interactive) {
     relight::InteractiveOptions io;
     io.preview = o.preview;
     io.show = o.show;
-    io.prompt = ::isatty(STDIN_FILENO) != 0;
-    relight::run_interactive(session, std::cin, std::cout, io);
+    io.show_every = o.show_every;
+    std::setlocale(LC_CTYPE, "");  // libedit reads the terminal's characters in the user's encoding
+    relight::run_interactive_terminal(session, io, std::cerr);
   }
   return spectral::kExitOk;
 }
@@ -170,7 +182,8 @@ int main(int argc, char** argv) {
   app.add_option("--batch", o.batch, "JSON file listing outputs and their settings (docs/relight.md)");
   app.add_flag("-i,--interactive", o.interactive, "read commands from stdin (type 'help')");
   app.add_option("--preview", o.preview, "interactive: image rewritten after every change");
-  app.add_flag("--show", o.show, "print a true-colour terminal thumbnail");
+  app.add_flag("--show", o.show, "print a true-colour terminal thumbnail (with -i: draw the image at the start)");
+  app.add_flag("--show-every", o.show_every, "interactive: draw the image after every change");
   app.add_flag("--verbose", o.verbose, "echo data files, OCIO config and lights");
   app.set_version_flag("--version", prizma::spectral::prizma_version());
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;

@@ -236,9 +236,16 @@ ProbeResult RelightSession::probe(int x, int y) {
 CompareResult RelightSession::compare(int x1, int y1, int x2, int y2, int radius) {
   check_pixel(x1, y1, "compare");
   check_pixel(x2, y2, "compare");
-  if (radius < 0) throw InputError("compare", "radius must be ≥ 0, not " + std::to_string(radius));
+  // A radius beyond the image's larger side covers nothing more; a larger one is a typo (and
+  // cx + radius would overflow).
+  const int max_radius = std::max(m_image.width, m_image.height);
+  if (radius < 0 || radius > max_radius) {
+    throw InputError("compare", "radius must be between 0 and " + std::to_string(max_radius) + ", not " +
+                                    std::to_string(radius));
+  }
   const XyzImage& img = xyz();
-  // Mean XYZ over the (2r+1)² square around (cx, cy), clipped to the image.
+  // Mean XYZ over the (2r+1)² square around (cx, cy), clipped to the image (never empty: the centre
+  // is inside).
   auto mean = [&](int cx, int cy) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int count = 0;

@@ -1,0 +1,244 @@
+#!/usr/bin/env python3
+"""prizma-relight -i in a real pseudo-terminal: a private tmux server of fixed size runs the shell,
+keys go in with send-keys, the screen comes back with capture-pane. Checks line editing (Up recalls
+the last command), Tab completion (a light name; a display name with a blank, quoted), history kept
+across sessions in $XDG_STATE_HOME/prizma/relight_history, status, adapt, undo, show, the pixel-index
+errors, and that a history that cannot be written, or is not libedit's, is only a warning.
+
+Every wait polls the screen until the expected text is there, with a bound (TIMEOUT_S); the tmux
+server is killed at the end whatever happened.
+
+usage: tmux_shell_test.py EXE SCENE.exr WORKDIR DATA_DIR [--transcript FILE]
+"""
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+
+TIMEOUT_S = 30.0
+PROMPT = "relight>"
+
+
+class Failure(Exception):
+    pass
+
+
+class Pane:
+    def __init__(self, server):
+        self.server = server
+        self.target = None
+        self.sessions = 0
+        self.socket = None
+
+    def tmux(self, *args, check=True):
+        r = subprocess.run(["tmux", "-L", self.server, "-u", "-f", "/dev/null", *args],
+                           capture_output=True, text=True, timeout=TIMEOUT_S)
+        if check and r.returncode != 0:
+            raise Failure(f"tmux {' '.join(args)}: {r.stderr.strip()}")
+        return r.stdout
+
+    def start(self, command):
+        # The command's exit status stays on the screen; the pane then waits to be killed.
+        # A new tmux session each time (the old ones stay until the server is killed: killing the
+        # last one would end the server while the next one is being started).
+        wrapped = f"{command}; echo \"[exited $?]\"; sleep {int(TIMEOUT_S * 10)}"
+        self.sessions += 1
+        self.target = f"s{self.sessions}"
+        self.tmux("new-session", "-d", "-s", self.target, "-x", "100", "-y", "40", "sh", "-c", wrapped)
+        if not self.socket:
+            self.socket = self.tmux("display-message", "-p", "#{socket_path}").strip()
+
+    def kill(self):
+        subprocess.run(["tmux", "-L", self.server, "kill-server"], capture_output=True, timeout=TIMEOUT_S)
+        if self.socket and os.path.exists(self.socket):
+            os.remove(self.socket)
+
+    def screen(self):
+        return self.tmux("capture-pane", "-p", "-J", "-S", "-5000", "-t", self.target)
+
+    def lines(self):
+        return [l.rstrip() for l in self.screen().split("\n")]
+
+    def last_line(self):
+        nonempty = [l for l in self.lines() if l]
+        return nonempty[-1] if nonempty else ""
+
+    def wait(self, what, predicate):
+        deadline = time.monotonic() + TIMEOUT_S
+        while time.monotonic() < deadline:
+            text = self.screen()
+            if predicate(text):
+                return text
+            time.sleep(0.05)
+        raise Failure(f"timed out waiting for {what}; the screen:\n{self.screen()}")
+
+    def wait_prompt(self, count=None):
+        """The prompt is the last line, empty (count: the number of prompts on the screen so far)."""
+        def ready(text):
+            lines = [l.rstrip() for l in text.split("\n") if l.strip()]
+            if not lines or lines[-1] != PROMPT:
+                return False
+            return count is None or sum(1 for l in lines if l.startswith(PROMPT)) >= count
+        return self.wait(f"prompt #{count}", ready)
+
+    def type(self, text):
+        self.tmux("send-keys", "-t", self.target, "-l", text)
+
+    def key(self, *keys):
+        self.tmux("send-keys", "-t", self.target, *keys)
+
+    def command(self, text):
+        """Types a command at a fresh prompt and waits for the next prompt."""
+        n = self.prompts()
+        self.type(text)
+        self.key("Enter")
+        return self.wait_prompt(n + 1)
+
+    def prompts(self):
+        return sum(1 for l in self.lines() if l.startswith(PROMPT))
+
+
+def expect(cond, message, screen=""):
+    if not cond:
+        raise Failure(message + ("\nthe screen:\n" + screen if screen else ""))
+
+
+def session_command(exe, scene, env):
+    assigns = " ".join(f"{k}={shlex.quote(v)}" for k, v in env.items())
+    return f"env -u PRIZMA_TERMINAL_IMAGES -u KITTY_WINDOW_ID {assigns} {shlex.quote(exe)} {shlex.quote(scene)} -i"
+
+
+def main():
+    args = sys.argv[1:]
+    transcript = None
+    if "--transcript" in args:
+        i = args.index("--transcript")
+        transcript = args[i + 1]
+        del args[i:i + 2]
+    exe, scene, work, data = args
+    shutil.rmtree(work, ignore_errors=True)
+    state = os.path.join(work, "state")
+    home = os.path.join(work, "home")
+    os.makedirs(home)
+    env = {"XDG_STATE_HOME": state, "HOME": home, "PRIZMA_DATA_DIR": data, "LANG": "C.UTF-8", "TERM": "screen"}
+    history = os.path.join(state, "prizma", "relight_history")
+
+    server = f"shell-test-{os.getpid()}"
+    pane = Pane(server)
+    try:
+        os.chdir(work)
+        # Session 1.
+        pane.start(session_command(exe, scene, env))
+        pane.wait_prompt(1)
+        # A command, then Up and Enter: it runs twice.
+        screen = pane.command("probe 1 1")
+        expect(screen.count("\n  XYZ ") == 1, "probe did not run", screen)
+        pane.key("Up")
+        pane.wait("Up to recall the command", lambda s: pane.last_line() == f"{PROMPT} probe 1 1")
+        pane.key("Enter")
+        screen = pane.wait_prompt(3)
+        outputs = [l for l in screen.split("\n") if l.rstrip() == "probe 1 1"]
+        expect(len(outputs) == 2, f"probe ran {len(outputs)} times, expected 2", screen)
+        expect("^[[A" not in screen and "unknown command" not in screen, "Up was not taken as a key", screen)
+        # Tab completes a light name; the command then runs.
+        pane.type("light k")
+        pane.key("Tab")
+        pane.wait("light name completed", lambda s: pane.last_line() == f"{PROMPT} light key")
+        n = pane.prompts()
+        pane.type("A")
+        pane.key("Enter")
+        screen = pane.wait_prompt(n + 1)
+        expect("error" not in screen, "light key A failed", screen)
+        # Tab completes a display name with a blank, quoted, and the quoted name works.
+        pane.type("display Di")
+        pane.key("Tab")
+        pane.wait("display completed in quotes", lambda s: pane.last_line() == f'{PROMPT} display "Display P3"')
+        n = pane.prompts()
+        pane.key("Enter")
+        pane.wait_prompt(n + 1)
+        pane.command("adapt on")
+        screen = pane.command("status")
+        for want in ["light       key = A (default D65)", "display     Display P3", "adaptation  on",
+                     "undo        3 levels"]:
+            expect(want in screen, f"status does not show '{want}'", screen)
+        pane.command("undo")
+        pane.command("undo")
+        screen = pane.command("status")
+        tail = screen[screen.rfind("file        "):]
+        for want in ["display     sRGB", "adaptation  off", "light       key = A", "undo        1 level"]:
+            expect(want in tail, f"status after two undos does not show '{want}'", tail)
+        # The pixel index of issue 11.
+        screen = pane.command("compare 0 0 99999999999 0")
+        expect('error: compare X2: 99999999999 is outside the' in screen, "no clear error for a huge index", screen)
+        # show: tmux answers the device-attributes query without sixel: half blocks, no hang.
+        screen = pane.command("show")
+        expect("\u2580" in screen, "show drew no half blocks", screen)
+        expect(screen.count("relit in ") >= 6, "changes did not print their relight time", screen)
+        pane.type("quit")
+        pane.key("Enter")
+        pane.wait("the first session to end", lambda s: "[exited 0]" in s)
+        if transcript:
+            with open(transcript, "w") as f:
+                f.write(pane.screen())
+
+        # The history file holds the session's lines.
+        expect(os.path.isfile(history), f"no history file at {history}")
+        with open(history, encoding="utf-8", errors="replace") as f:
+            saved = f.read()
+        expect("probe" in saved and "quit" in saved, f"history file lacks the commands:\n{saved}")
+
+        # Session 2: Up recalls the first session's commands, newest first.
+        pane.start(session_command(exe, scene, env))
+        pane.wait_prompt(1)
+        pane.key("Up")
+        pane.wait("the last command of session 1", lambda s: pane.last_line() == f"{PROMPT} quit")
+        pane.key("Up")
+        pane.wait("the one before", lambda s: pane.last_line() == f"{PROMPT} show")
+        pane.key("Up")
+        pane.wait("and the one before", lambda s: pane.last_line() == f"{PROMPT} compare 0 0 99999999999 0")
+        pane.key("C-u")
+        pane.wait("the line cleared", lambda s: pane.last_line() == PROMPT)
+        pane.type("quit")
+        pane.key("Enter")
+        pane.wait("the second session to end", lambda s: "[exited 0]" in s)
+
+        # Session 3: a history that cannot be written is a warning; the session goes on.
+        bad = dict(env, XDG_STATE_HOME="/proc/self/prizma-cannot-be-here")
+        pane.start(session_command(exe, scene, bad))
+        pane.wait_prompt(1)
+        screen = pane.command("status")
+        expect("warning:" in screen and "history not saved" in screen, "no warning for an unwritable history", screen)
+        expect("exposure    0 EV" in screen, "status did not run after the warning", screen)
+        pane.type("quit")
+        pane.key("Enter")
+        pane.wait("the third session to end", lambda s: "[exited 0]" in s)
+
+        # Session 4: a history file that is not libedit's is neither read nor overwritten.
+        foreign_state = os.path.join(work, "foreign")
+        os.makedirs(os.path.join(foreign_state, "prizma"))
+        foreign = os.path.join(foreign_state, "prizma", "relight_history")
+        with open(foreign, "w") as f:
+            f.write("my own notes\n")
+        pane.start(session_command(exe, scene, dict(env, XDG_STATE_HOME=foreign_state)))
+        screen = pane.wait_prompt(1)
+        expect("history not loaded" in screen, "no warning for a foreign history file", screen)
+        pane.command("exposure 1")
+        pane.type("quit")
+        pane.key("Enter")
+        pane.wait("the fourth session to end", lambda s: "[exited 0]" in s)
+        with open(foreign) as f:
+            expect(f.read() == "my own notes\n", "the foreign history file was overwritten")
+        print("terminal session test passed")
+        return 0
+    except Failure as e:
+        print(f"FAILED: {e}", file=sys.stderr)
+        return 1
+    finally:
+        pane.kill()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
