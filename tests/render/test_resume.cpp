@@ -146,6 +146,36 @@ TEST(MergeTolerance, ShardsAndResumedRendersMatchOneRender) {
   EXPECT_LE(worst_var, 1e-5);
 }
 
+// Low-noise pixels: the variance far below mean² (here 1e-17 of it, below what a float mean
+// resolves). Recombining through Σx² − n·mean² (the merge before Chan's formula, in double) cancels
+// all digits there; merging two hand-made shards must still give the variance of their union.
+TEST(MergeTolerance, VarianceOfLowNoisePixelsSurvivesTheMerge) {
+  auto shard = [](float mean, float var_of_mean, std::int64_t n, std::int64_t begin) {
+    spectral::SpectralImage img;
+    img.width = img.height = 1;
+    img.bins = spectral::BinLayout::parse("linear:400:700:1", "bins");
+    img.lights.resize(1);
+    img.lights[0].name = "env";
+    img.lights[0].data = {mean};
+    img.lights[0].variance = {var_of_mean};
+    img.info.is_prizma = true;
+    img.info.samples = n;
+    img.info.sample_range = SampleRange{begin, begin + n}.to_string();
+    return img;
+  };
+  const std::int64_t n = 1000;
+  const auto a = shard(1.0f, 1e-20f, n, 0), b = shard(1.0000002f, 2e-20f, n, n);
+  // The exact variance of the mean of the union, from the same float inputs.
+  const long double ma = a.lights[0].data[0], mb = b.lights[0].data[0], N = 2.0L * n;
+  const long double m = (ma + mb) / 2.0L;
+  const long double m2 = (n - 1.0L) * n * a.lights[0].variance[0] + (n - 1.0L) * n * b.lights[0].variance[0] +
+                         n * (ma - m) * (ma - m) + n * (mb - m) * (mb - m);
+  const double expected = static_cast<double>(m2 / (N - 1.0L) / N);
+  const auto merged = merge_shards({a, b});
+  EXPECT_NEAR(merged.lights[0].variance[0], expected, 1e-5 * expected);
+  EXPECT_NEAR(merged.lights[0].data[0], static_cast<double>(m), 1e-7);
+}
+
 TEST(MergeTolerance, NamesShardsByFile) {
   Scene s = chromatic_scene(4);
   s.settings.write_variance = false;
