@@ -62,6 +62,8 @@ constexpr const char* kAttrSceneHash = "prizma:sceneHash";
 constexpr const char* kAttrVersion = "prizma:version";
 constexpr const char* kAttrWavelengthSampling = "prizma:wavelengthSampling";
 constexpr const char* kAttrChecksum = "prizma:checksum";
+constexpr const char* kAttrScenePath = "prizma:scenePath";
+constexpr const char* kAttrRenderOptions = "prizma:renderOptions";
 constexpr const char* kChecksumScheme = "fnv1a64-words:";
 constexpr const char* kVarianceLayer = "var";
 constexpr float kHalfMax = 65504.0f;
@@ -371,6 +373,8 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   if (!info.wavelength_sampling.empty()) {
     header.insert(kAttrWavelengthSampling, Imf::StringAttribute(info.wavelength_sampling));
   }
+  if (!info.scene_path.empty()) header.insert(kAttrScenePath, Imf::StringAttribute(info.scene_path));
+  if (!info.render_options.empty()) header.insert(kAttrRenderOptions, Imf::StringAttribute(info.render_options));
   header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum)));
 
   // Frame buffer: slices point straight into the pixel-major, bin-contiguous buffers (bin i of pixel
@@ -617,6 +621,8 @@ SpectralImage read_spectral_exr(const fs::path& path) {
     if (const auto* s = find_string_attr(header, kAttrSceneHash)) info.scene_hash = *s;
     if (const auto* s = find_string_attr(header, kAttrVersion)) info.version = *s;
     if (const auto* s = find_string_attr(header, kAttrWavelengthSampling)) info.wavelength_sampling = *s;
+    if (const auto* s = find_string_attr(header, kAttrScenePath)) info.scene_path = *s;
+    if (const auto* s = find_string_attr(header, kAttrRenderOptions)) info.render_options = *s;
     info.samples = int_attr(header, kAttrSamples, p);
     info.seed = int_attr(header, kAttrSeed, p);
     nlohmann::json lights_json;

@@ -1,5 +1,6 @@
 // prizma-render: renders a scene file to a spectral EXR (one transport layer per light), or merges
 // shards rendered over disjoint sample ranges. Thin: options → Scene overrides → render() → file.
+#include <signal.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
 
@@ -13,6 +14,8 @@
 #include <vector>
 
 #include "prizma/render/render.h"
+#include "prizma/render/resume.h"
+#include "prizma/render/sample_range.h"
 #include "prizma/render/scene.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/error.h"
@@ -26,19 +29,36 @@ namespace render = prizma::render;
 namespace spectral = prizma::spectral;
 
 constexpr const char* kProgram = "prizma-render";
-constexpr int kExitInterrupted = 130;
 
 std::atomic<bool> g_cancel{false};
+std::atomic<int> g_signal{0};  // the first of SIGINT, SIGTERM, SIGHUP received, or 0
 
-extern "C" void on_sigint(int) {
-  // First Ctrl-C: finish the current pass and write what is done. Second: abort, write nothing.
-  if (g_cancel.exchange(true)) std::_Exit(kExitInterrupted);
+// SIGINT (Ctrl-C), SIGTERM (Slurm, systemd, kill) and SIGHUP (a closed terminal) alike. The first
+// lets the current pass finish and writes what is done; exit 128 + signal. A second exits at once
+// with 128 + its number and writes nothing.
+extern "C" void on_signal(int sig) {
+  int none = 0;
+  if (!g_signal.compare_exchange_strong(none, sig)) std::_Exit(128 + sig);
+  g_cancel.store(true);
+}
+
+void catch_interruptions() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
+}
+
+const char* signal_name(int sig) {
+  return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "a signal";
 }
 
 struct Options {
   std::string scene;
   std::string output;
   std::optional<std::int64_t> spp;
+  std::string spp_text;  // parsed by parse_sample_count: CLI11 wraps values beyond int64
   std::optional<int> width, height;
   std::string bins;
   std::optional<std::uint64_t> seed;
@@ -55,24 +75,6 @@ struct Options {
   bool verbose = false;
 };
 
-// "A:B" → [A, B).
-std::pair<std::int64_t, std::int64_t> parse_range(const std::string& text, const std::string& input) {
-  const auto colon = text.find(':');
-  try {
-    if (colon == std::string::npos) throw std::invalid_argument("no colon");
-    std::size_t used = 0;
-    const long long a = std::stoll(text.substr(0, colon), &used);
-    if (used != colon) throw std::invalid_argument("junk");
-    const std::string rest = text.substr(colon + 1);
-    const long long b = std::stoll(rest, &used);
-    if (used != rest.size()) throw std::invalid_argument("junk");
-    if (a < 0 || b <= a) throw std::invalid_argument("order");
-    return {a, b};
-  } catch (const std::exception&) {
-    throw InputError(input, "expected A:B with 0 ≤ A < B, got \"" + text + "\"");
-  }
-}
-
 // Refuses before rendering when the output's folder is missing or not writable.
 void check_writable(const std::filesystem::path& path, const std::string& input) {
   std::filesystem::path dir = path.parent_path();
@@ -84,8 +86,17 @@ void check_writable(const std::filesystem::path& path, const std::string& input)
 
 class ProgressBar {
  public:
-  explicit ProgressBar(bool enabled) : m_enabled(enabled) {}
+  // enabled: a bar on a terminal; lines: one line per pass instead (logs, -v without a terminal).
+  ProgressBar(bool enabled, bool lines, std::int64_t first_sample)
+      : m_enabled(enabled), m_lines(lines), m_first(first_sample) {}
   void update(const render::RenderProgress& p) {
+    if (m_lines && !m_enabled) {
+      std::fprintf(stderr, "%s: pass done: samples %lld:%lld of %lld:%lld\n", kProgram,
+                   static_cast<long long>(m_first), static_cast<long long>(m_first + p.samples_done),
+                   static_cast<long long>(m_first), static_cast<long long>(m_first + p.samples_total));
+      std::fflush(stderr);
+      return;
+    }
     if (!m_enabled) return;
     const double frac = p.samples_total > 0 ? static_cast<double>(p.samples_done) / p.samples_total : 1.0;
     const int filled = static_cast<int>(frac * 30.0);
@@ -104,6 +115,8 @@ class ProgressBar {
 
  private:
   bool m_enabled;
+  bool m_lines;
+  std::int64_t m_first;
   bool m_drawn = false;
 };
 
@@ -126,22 +139,34 @@ int merge_main(int argc, char** argv) {
   app.set_version_flag("--version", spectral::prizma_version());
   std::vector<std::string> inputs;
   std::string output, preview;
-  bool half = false, quiet = false;
+  bool half = false, quiet = false, strict = false;
   app.add_option("shards", inputs, "shard files (spectral EXR written by prizma-render)")->required();
   app.add_option("-o,--output", output, "merged output file")->required();
   app.add_option("--preview", preview, "also write an sRGB preview (PNG) under the lights' default spectra");
   app.add_flag("--half", half, "write half floats");
+  app.add_flag("--strict", strict, "refuse shards that leave a gap in the sample range (exit 2)");
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
   if (const int rc = spectral::parse_command_line(app, argc - 1, argv + 1); rc >= 0) return rc;
   return spectral::run_tool(kProgram, [&] {
     check_writable(output, "-o");
     std::vector<spectral::SpectralImage> shards;
     for (const auto& f : inputs) shards.push_back(spectral::read_spectral_exr(f));
-    const auto merged = render::merge_shards(shards);
+    const auto merged = render::merge_shards(shards, inputs);
+    if (merged.info.sample_range.find(',') != std::string::npos) {
+      // The union has gaps: a valid render of fewer samples, but most likely a shard is missing.
+      const auto held = render::parse_sample_ranges(merged.info.sample_range, "merge");
+      std::string gaps;
+      for (std::size_t k = 1; k < held.size(); ++k)
+        gaps += (gaps.empty() ? "" : ", ") + render::SampleRange{held[k - 1].end, held[k].begin}.to_string();
+      const std::string what = "the shards leave a gap in the sample range: samples " + gaps +
+                               " are missing (the shards hold " + merged.info.sample_range + ")";
+      if (strict) throw InputError("merge", what);
+      std::cerr << kProgram << ": warning: " << what << "\n";
+    }
     write_outputs(merged, output, half, preview, render::lights_from_image(merged), {});
     if (!quiet)
-      std::cerr << kProgram << ": merged " << shards.size() << " shards, samples " << merged.info.sample_range
-                << " → " << output << "\n";
+      std::cerr << kProgram << ": merged " << shards.size() << (shards.size() == 1 ? " shard" : " shards")
+                << ", samples " << merged.info.sample_range << " → " << output << "\n";
     return spectral::kExitOk;
   });
 }
@@ -158,10 +183,9 @@ int main(int argc, char** argv) {
                kProgram};
   app.set_version_flag("--version", spectral::prizma_version());
   Options o;
-  app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md)")->required();
+  app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own");
   app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")");
-  app.add_option("--spp", o.spp, "samples per pixel (renders samples [begin, begin + N))")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--spp", o.spp_text, "samples per pixel (renders samples [begin, begin + N); with --resume the total)");
   app.add_option("--width", o.width, "image width in pixels")->check(CLI::PositiveNumber);
   app.add_option("--height", o.height, "image height in pixels")->check(CLI::PositiveNumber);
   app.add_option("--bins", o.bins, "bin layout: linear:400:700:12, exp:400:700:12:1.5, edges:400,450,500");
@@ -179,43 +203,65 @@ int main(int argc, char** argv) {
   app.add_flag("--half", o.half, "write half floats (refused where values exceed half's range)");
   app.add_option("--preview", o.preview, "also write an sRGB preview (PNG) under the lights' default spectra");
   app.add_option("--resume", o.resume,
-                 "continue a partial render: render the samples after the file's range up to the target "
-                 "and merge (output defaults to this file)");
+                 "continue a partial (interrupted) render from the scene and options it records, up to "
+                 "its target or --spp N in all, and merge (output defaults to this file)");
   app.add_flag("-q,--quiet", o.quiet, "no progress bar or summary");
   app.add_flag("-v,--verbose", o.verbose, "print the scene, mode and statistics");
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   return spectral::run_tool(kProgram, [&] {
-    render::Scene scene = render::load_scene(o.scene);
-    auto& st = scene.settings;
-    if (o.width) scene.camera.width = *o.width;
-    if (o.height) scene.camera.height = *o.height;
-    if (!o.bins.empty()) st.bins = spectral::BinLayout::parse(o.bins, "--bins");
-    if (o.seed) st.seed = *o.seed;
+    if (!o.spp_text.empty()) o.spp = render::parse_sample_count(o.spp_text, "--spp");
+    render::RenderOverrides given;
+    given.width = o.width;
+    given.height = o.height;
+    if (!o.bins.empty()) given.bins = o.bins;
+    given.seed = o.seed;
+    if (!o.wavelength_sampling.empty()) given.wavelength_sampling = o.wavelength_sampling;
+    given.target_error = o.target_error;
+    given.no_majorant_grid = o.no_majorant_grid;
+    given.variance = o.variance;
+    given.half = o.half;
     if (!o.samples.empty()) {
       if (o.spp) throw InputError("--samples", "give either --samples or --spp");
-      std::tie(st.sample_begin, st.sample_end) = parse_range(o.samples, "--samples");
+      given.samples = render::SampleRange::parse(o.samples, "--samples");
     }
-    if (o.spp) st.sample_end = st.sample_begin + *o.spp;
-    if (o.threads > 0) st.threads = o.threads;
-    if (!o.wavelength_sampling.empty())
-      st.wavelength_sampling = render::parse_wavelength_sampling(o.wavelength_sampling, "--wavelength-sampling");
-    if (o.target_error) st.target_error = *o.target_error;
-    if (o.no_majorant_grid) st.use_majorant_grid = false;
-    if (o.variance) st.write_variance = true;
 
+    render::Scene scene;
+    render::RenderOverrides recorded;  // what the output will record in prizma:renderOptions
     std::optional<spectral::SpectralImage> previous;
     if (!o.resume.empty()) {
-      previous = spectral::read_spectral_exr(o.resume);
-      const auto range = parse_range(previous->info.sample_range, o.resume + ": prizma:sampleRange");
-      const std::int64_t target = o.spp ? range.first + *o.spp : st.sample_end;
-      st.sample_begin = range.second;
-      st.sample_end = target;
-      if (st.sample_end <= st.sample_begin)
-        throw InputError("--resume", o.resume + " already holds samples " + previous->info.sample_range +
-                                         " (target " + std::to_string(target) + ")");
-      st.write_variance = st.write_variance || !previous->lights.front().variance.empty();
+      render::ResumeRequest req{o.resume, o.scene, given, o.spp};
+      render::ResumePlan plan = render::plan_resume(req);
+      std::error_code ec;
+      if (plan.complete && (o.output.empty() || std::filesystem::equivalent(o.output, o.resume, ec))) {
+        if (!o.quiet)
+          std::cerr << kProgram << ": " << o.resume << " already holds samples " << plan.held.to_string()
+                    << ", all that were asked for: nothing to render\n";
+        return spectral::kExitOk;
+      }
+      if (plan.complete) {
+        check_writable(o.output, "-o");
+        plan.previous.info.render_options = render::overrides_to_json(plan.overrides);
+        write_outputs(plan.previous, o.output, plan.overrides.half, o.preview, plan.scene.lights,
+                      plan.scene.source.parent_path());
+        return spectral::kExitOk;
+      }
+      scene = std::move(plan.scene);
+      recorded = plan.overrides;
+      previous = std::move(plan.previous);
+    } else {
+      if (o.scene.empty()) throw InputError("scene", "no scene file given (or --resume a partial render)");
+      scene = render::load_scene(o.scene);
+      render::apply_overrides(scene, given);
+      auto& st = scene.settings;
+      if (given.samples) std::tie(st.sample_begin, st.sample_end) = std::pair(given.samples->begin, given.samples->end);
+      if (o.spp) st.sample_end = render::SampleRange::starting_at(st.sample_begin, *o.spp, "--spp").end;
+      recorded = given;
+      recorded.samples = render::SampleRange{st.sample_begin, st.sample_end};
     }
+    auto& st = scene.settings;
+    if (o.threads > 0) st.threads = o.threads;
+    const bool half = recorded.half;
 
     std::filesystem::path output = o.output;
     if (output.empty()) output = o.resume.empty() ? scene.output : std::filesystem::path(o.resume);
@@ -227,7 +273,7 @@ int main(int argc, char** argv) {
     if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
 
     if (o.verbose) {
-      std::cerr << kProgram << ": scene " << o.scene << " (hash " << scene.hash << "), "
+      std::cerr << kProgram << ": scene " << scene.source.string() << " (hash " << scene.hash << "), "
                 << scene.camera.width << "×" << scene.camera.height << ", " << st.bins.size() << " bins "
                 << st.bins.to_string() << ", samples " << st.sample_begin << ":" << st.sample_end << ", seed "
                 << st.seed << ", " << render::wavelength_sampling_name(st.wavelength_sampling)
@@ -237,17 +283,31 @@ int main(int argc, char** argv) {
                   << ") angular size " << l.angular_size_deg << "° default spectrum " << l.spectrum_spec << "\n";
     }
 
-    std::signal(SIGINT, on_sigint);
-    ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
+    catch_interruptions();
+    ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO), o.verbose, st.sample_begin);
     render::RenderCallbacks cb;
     cb.cancel = &g_cancel;
     cb.progress = [&](const render::RenderProgress& p) { bar.update(p); };
     render::RenderStats stats;
-    spectral::SpectralImage image = render::render(scene, cb, &stats);
+    spectral::SpectralImage image;
+    try {
+      image = render::render(scene, cb, &stats);
+    } catch (const spectral::RuntimeError& e) {
+      if (g_signal.load() == 0) throw;
+      bar.finish();
+      std::cerr << kProgram << ": error: " << signal_name(g_signal.load()) << ": " << e.what()
+                << "; nothing written\n";
+      return 128 + g_signal.load();
+    }
     bar.finish();
-    if (previous) image = render::merge_shards({*previous, image});
+    image.info.scene_path = std::filesystem::absolute(scene.source).lexically_normal().string();
+    image.info.render_options = render::overrides_to_json(recorded);
+    if (previous) {
+      image = render::merge_shards({*previous, image}, {o.resume, "the resumed samples"});
+      image.info.render_options = render::overrides_to_json(recorded);  // the target, not the union
+    }
 
-    write_outputs(image, output, o.half, o.preview, scene.lights,
+    write_outputs(image, output, half, o.preview, scene.lights,
                   scene.source.empty() ? std::filesystem::path() : scene.source.parent_path());
 
     if (stats.nan_or_inf_count > 0)
@@ -257,7 +317,9 @@ int main(int argc, char** argv) {
       std::cerr << kProgram << ": " << image.info.samples << " spp (" << image.info.sample_range << "), "
                 << stats.paths << " paths in " << stats.wall_seconds << " s ("
                 << (stats.wall_seconds > 0 ? stats.paths / stats.wall_seconds * 1e-6 : 0.0) << " Mpaths/s) → "
-                << output.string() << (stats.interrupted ? " [interrupted]" : "") << "\n";
+                << output.string()
+                << (stats.interrupted ? std::string(" [interrupted by ") + signal_name(g_signal.load()) + "]" : "")
+                << "\n";
       if (o.verbose)
         std::cerr << kProgram << ": paths in volume " << stats.paths_in_volume << ", collisions "
                   << stats.collisions << ", shadow steps " << stats.shadow_steps << ", majorant cells "
@@ -265,6 +327,6 @@ int main(int argc, char** argv) {
                   << (stats.wavelength_independent ? ", wavelength-independent medium (one lane)" : "")
                   << "\n";
     }
-    return stats.interrupted ? kExitInterrupted : spectral::kExitOk;
+    return stats.interrupted ? 128 + (g_signal.load() != 0 ? g_signal.load() : SIGINT) : spectral::kExitOk;
   });
 }

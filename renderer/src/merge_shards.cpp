@@ -6,53 +6,30 @@
 #include <utility>
 
 #include "prizma/render/render.h"
+#include "prizma/render/sample_range.h"
 #include "prizma/spectral/error.h"
 
 namespace prizma::render {
 namespace {
 
 using spectral::InputError;
-using Range = std::pair<std::int64_t, std::int64_t>;
 
-// "0:8" or "0:8,16:24" → ranges; throws for anything else.
-std::vector<Range> parse_ranges(const std::string& text, std::int64_t samples) {
-  std::vector<Range> out;
-  if (text.empty()) {
-    out.emplace_back(0, samples);
-    return out;
+// prizma:renderOptions of the merge: the shards' common options with the union as the target range
+// (so that a merged file can be extended with --resume), or none when the shards differ in more.
+std::string merged_options(const std::vector<spectral::SpectralImage>& shards,
+                           const std::vector<SampleRange>& joined) {
+  nlohmann::json common;
+  for (const auto& s : shards) {
+    nlohmann::json j = nlohmann::json::parse(s.info.render_options, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_object()) return {};
+    j.erase("samples");
+    if (common.is_null())
+      common = j;
+    else if (j != common)
+      return {};
   }
-  std::size_t pos = 0;
-  while (pos <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', pos), text.size());
-    const std::string part = text.substr(pos, comma - pos);
-    const std::size_t colon = part.find(':');
-    char* end = nullptr;
-    if (colon == std::string::npos) throw InputError("merge", "bad sample range \"" + text + "\"");
-    const long long a = std::strtoll(part.c_str(), &end, 10);
-    if (end != part.c_str() + colon) throw InputError("merge", "bad sample range \"" + text + "\"");
-    const long long b = std::strtoll(part.c_str() + colon + 1, &end, 10);
-    if (*end != '\0' || b <= a || a < 0) throw InputError("merge", "bad sample range \"" + text + "\"");
-    out.emplace_back(a, b);
-    pos = comma + 1;
-  }
-  return out;
-}
-
-std::string format_ranges(std::vector<Range> ranges) {
-  std::sort(ranges.begin(), ranges.end());
-  std::vector<Range> merged;
-  for (const auto& r : ranges) {
-    if (!merged.empty() && merged.back().second == r.first)
-      merged.back().second = r.second;
-    else
-      merged.push_back(r);
-  }
-  std::string s;
-  for (const auto& r : merged) {
-    if (!s.empty()) s += ",";
-    s += std::to_string(r.first) + ":" + std::to_string(r.second);
-  }
-  return s;
+  if (joined.size() == 1) common["samples"] = joined.front().to_string();
+  return common.dump();
 }
 
 }  // namespace
@@ -93,16 +70,21 @@ std::vector<Light> lights_from_image(const spectral::SpectralImage& image) {
   return out;
 }
 
-spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards) {
+spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards,
+                                     const std::vector<std::string>& names) {
   if (shards.empty()) throw InputError("merge", "no shards to merge");
+  auto name = [&](std::size_t k) { return k < names.size() ? names[k] : "shard " + std::to_string(k + 1); };
   const auto& first = shards.front();
-  std::vector<Range> ranges;
+  struct Held {
+    SampleRange range;
+    std::size_t shard;
+  };
+  std::vector<Held> held;
   bool all_variance = true;
   for (std::size_t k = 0; k < shards.size(); ++k) {
     const auto& s = shards[k];
-    const std::string which = "shard " + std::to_string(k + 1);
     auto refuse = [&](const std::string& what) {
-      throw InputError("merge", which + ": " + what + " differs from shard 1");
+      throw InputError(name(k), what + " differs from " + name(0));
     };
     if (s.width != first.width || s.height != first.height) refuse("image size");
     if (!(s.bins == first.bins)) refuse("bin layout");
@@ -112,26 +94,36 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
     if (s.info.lights_json != first.info.lights_json || s.lights.size() != first.lights.size()) refuse("lights");
     for (std::size_t l = 0; l < s.lights.size(); ++l)
       if (s.lights[l].name != first.lights[l].name) refuse("lights");
-    if (s.info.samples <= 0) throw InputError("merge", which + ": no samples");
+    if (s.info.samples <= 0) throw InputError(name(k), "holds no samples");
     for (const auto& l : s.lights) all_variance = all_variance && !l.variance.empty();
-    auto r = parse_ranges(s.info.sample_range, s.info.samples);
+    const auto r = s.info.sample_range.empty()
+                       ? std::vector<SampleRange>{{0, s.info.samples}}
+                       : parse_sample_ranges(s.info.sample_range, name(k) + ": prizma:sampleRange");
     std::int64_t n = 0;
-    for (const auto& x : r) n += x.second - x.first;
+    for (const auto& x : r) n += x.size();
     if (n != s.info.samples)
-      throw InputError("merge", which + ": sample range " + s.info.sample_range + " does not hold " +
-                                    std::to_string(s.info.samples) + " samples");
-    ranges.insert(ranges.end(), r.begin(), r.end());
+      throw InputError(name(k), "prizma:sampleRange " + s.info.sample_range + " does not hold " +
+                                    std::to_string(s.info.samples) + " samples (prizma:samples)");
+    for (const auto& x : r) held.push_back({x, k});
   }
-  auto sorted = ranges;
-  std::sort(sorted.begin(), sorted.end());
-  for (std::size_t k = 1; k < sorted.size(); ++k)
-    if (sorted[k].first < sorted[k - 1].second)
-      throw InputError("merge", "sample ranges overlap (" + std::to_string(sorted[k - 1].first) + ":" +
-                                    std::to_string(sorted[k - 1].second) + " and " +
-                                    std::to_string(sorted[k].first) + ":" + std::to_string(sorted[k].second) +
-                                    ")");
+  std::sort(held.begin(), held.end(), [](const Held& a, const Held& b) {
+    return a.range != b.range ? a.range < b.range : a.shard < b.shard;
+  });
+  for (std::size_t k = 1; k < held.size(); ++k) {
+    const Held& a = held[k - 1];
+    const Held& b = held[k];
+    if (b.range.begin < a.range.end)
+      throw InputError(name(b.shard), "samples " + b.range.to_string() + " overlap samples " +
+                                          a.range.to_string() + " of " +
+                                          (a.shard == b.shard ? std::string("the same file") : name(a.shard)) +
+                                          " (sample ranges overlap)");
+  }
+  std::vector<SampleRange> ranges;
+  for (const auto& h : held) ranges.push_back(h.range);
 
-  // Means weighted by sample counts; variances of the mean recombined from each shard's sums.
+  // Means weighted by sample counts. Variances of the mean recombined as in Chan et al.'s parallel
+  // algorithm: M2 = Σ M2_i + Σ n_i·(mean_i − mean)², with M2_i = (n_i − 1)·s_i² and s_i² = n_i·(variance
+  // of the mean); unlike Σx² − n·mean² this does not cancel when the variance is small next to mean².
   spectral::SpectralImage out = first;
   std::int64_t total = 0;
   for (const auto& s : shards) total += s.info.samples;
@@ -139,30 +131,35 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
   for (std::size_t l = 0; l < out.lights.size(); ++l) {
     auto& layer = out.lights[l];
     const std::size_t size = layer.data.size();
-    std::vector<double> sum(size, 0.0), sum_sq(all_variance ? size : 0, 0.0);
+    std::vector<double> sum(size, 0.0);
     for (const auto& s : shards) {
       const auto& src = s.lights[l];
       const double n = static_cast<double>(s.info.samples);
-      for (std::size_t k = 0; k < size; ++k) {
-        const double mean = src.data[k];
-        sum[k] += n * mean;
-        // Σx² = (n − 1)·s² + n·mean², with s² = n·(variance of the mean).
-        if (all_variance) sum_sq[k] += (n - 1.0) * n * src.variance[k] + n * mean * mean;
-      }
+      for (std::size_t k = 0; k < size; ++k) sum[k] += n * static_cast<double>(src.data[k]);
     }
+    for (std::size_t k = 0; k < size; ++k) sum[k] /= n_total;  // now the mean
     layer.variance.clear();
-    if (all_variance) layer.variance.assign(size, 0.0f);
-    for (std::size_t k = 0; k < size; ++k) {
-      const double mean = sum[k] / n_total;
-      layer.data[k] = static_cast<float>(mean);
-      if (all_variance && total > 1) {
-        const double var = std::max(0.0, (sum_sq[k] - n_total * mean * mean) / (n_total - 1.0));
-        layer.variance[k] = static_cast<float>(var / n_total);
+    if (all_variance && total > 1) {
+      std::vector<double> m2(size, 0.0);
+      for (const auto& s : shards) {
+        const auto& src = s.lights[l];
+        const double n = static_cast<double>(s.info.samples);
+        for (std::size_t k = 0; k < size; ++k) {
+          const double d = static_cast<double>(src.data[k]) - sum[k];
+          m2[k] += (n - 1.0) * n * static_cast<double>(src.variance[k]) + n * d * d;
+        }
       }
+      layer.variance.resize(size);
+      for (std::size_t k = 0; k < size; ++k)
+        layer.variance[k] = static_cast<float>(std::max(0.0, m2[k] / (n_total - 1.0)) / n_total);
+    } else if (all_variance) {
+      layer.variance.assign(size, 0.0f);
     }
+    for (std::size_t k = 0; k < size; ++k) layer.data[k] = static_cast<float>(sum[k]);
   }
   out.info.samples = total;
-  out.info.sample_range = format_ranges(ranges);
+  out.info.sample_range = format_sample_ranges(ranges);
+  out.info.render_options = merged_options(shards, join_sample_ranges(ranges));
   return out;
 }
 

@@ -15,6 +15,7 @@
 #include "prizma/render/camera.h"
 #include "prizma/render/path_tracer.h"
 #include "prizma/render/rng.h"
+#include "prizma/render/sample_range.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
 #include "prizma/spectral/tool_main.h"
@@ -265,7 +266,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   img.info.is_prizma = true;
   img.info.lights_json = lights_to_json(scene.lights);
   img.info.samples = done;
-  img.info.sample_range = std::to_string(st.sample_begin) + ":" + std::to_string(st.sample_begin + done);
+  img.info.sample_range = SampleRange{st.sample_begin, st.sample_begin + done}.to_string();
   img.info.seed = static_cast<std::int64_t>(st.seed);
   img.info.scene_hash = scene.hash;
   img.info.version = spectral::prizma_version();

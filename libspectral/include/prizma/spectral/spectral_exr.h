@@ -19,6 +19,8 @@ struct SpectralExrInfo {
   std::string scene_hash;        // prizma:sceneHash
   std::string version;           // prizma:version
   std::string wavelength_sampling;  // prizma:wavelengthSampling
+  std::string scene_path;        // prizma:scenePath, the scene file (absolute) the render read
+  std::string render_options;    // prizma:renderOptions (JSON object: the command-line overrides)
   bool is_prizma = false;        // read: the file carried prizma: attributes
 };
 

@@ -55,10 +55,13 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
 
 // Combines renders of disjoint sample ranges of the same scene into the render of their union
 // (weighted by sample counts; variance layers combined when all shards carry them). Throws
-// InputError (input "merge") for an empty list, different scene hash, seed, bins, size, lights or
-// wavelength sampling, or overlapping sample ranges. Ranges need not be contiguous; the result's
-// sampleRange is "min:max" when they are and lists them ("0:8,16:24") otherwise.
-spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards);
+// InputError for an empty list, different scene hash, seed, bins, size, lights or wavelength
+// sampling, or overlapping sample ranges, naming the shard by names[k] (its file) where given, else
+// "shard k". Ranges need not be contiguous; the result's sampleRange is "min:max" when they are and
+// lists them ("0:8,16:24") otherwise. prizma:renderOptions: the shards' common options with the
+// union as target range (empty when the shards' options differ).
+spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards,
+                                     const std::vector<std::string>& names = {});
 
 // The scene's lights in the JSON form stored in prizma:lights.
 std::string lights_to_json(const std::vector<Light>& lights);

@@ -1,0 +1,48 @@
+# Interruptions and --resume (tests/e2e/resume/interrupt-and-resume): SIGINT, SIGTERM and SIGHUP keep
+# the completed passes, a second signal writes nothing, --resume needs only the file and matches the
+# uninterrupted render within the merge tolerance, a changed scene is refused. Label "resume".
+if(NOT TARGET prizma-render)
+  return()
+endif()
+find_program(PRIZMA_SYSTEM_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT PRIZMA_SYSTEM_PYTHON3)
+  message(STATUS "tests/e2e/resume.cmake: /usr/bin/python3 not found, interruption tests skipped")
+  return()
+endif()
+
+# Compares two renders of the same samples within the merge tolerance (also used by slurm.cmake).
+add_executable(prizma-test-exr-compare ${PRIZMA_E2E_DIR}/resume/exr_compare.cpp)
+target_link_libraries(prizma-test-exr-compare PRIVATE prizma::spectral)
+prizma_set_warnings(prizma-test-exr-compare)
+
+foreach(case signal-INT signal-TERM signal-HUP second-signal resume changed-scene)
+  add_test(NAME resume.e2e.${case}
+           COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${PRIZMA_E2E_DIR}/resume/interrupt-and-resume ${case}
+                   --render $<TARGET_FILE:prizma-render> --compare $<TARGET_FILE:prizma-test-exr-compare>
+                   --scene ${PRIZMA_E2E_DIR}/render/tiny.json --workdir ${PRIZMA_E2E_WORK}/resume)
+  set_tests_properties(resume.e2e.${case} PROPERTIES LABELS resume TIMEOUT 600
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+endforeach()
+
+# merge: a gap in the sample range warns (the merged file is written), --strict refuses it; shards
+# are named by file; one shard is "1 shard". A huge --spp is refused with the reason. (Shards of the
+# render_shards fixture in tests/e2e/render.cmake: shard0.exr holds 0:2, shard1.exr 2:4.)
+prizma_render_e2e(shard_gap "${PRIZMA_E2E_DIR}/render/tiny.json|--samples|6:8|-o|shard_gap.exr|-q"
+  MUST_EXIST shard_gap.exr FIXTURES_SETUP render_shards)
+prizma_render_e2e(merge_gap_warns "merge|shard0.exr|shard_gap.exr|-o|gap.exr" MUST_EXIST gap.exr
+  ERR_REGEX "warning: the shards leave a gap in the sample range: samples 2:6 are missing \\(the shards hold 0:2,6:8\\)"
+  FIXTURES_REQUIRED render_shards)
+prizma_render_e2e(merge_gap_strict "merge|shard0.exr|shard_gap.exr|shard1.exr|-o|gap_strict.exr|--strict"
+  EXPECT_RC 2 MUST_NOT_EXIST gap_strict.exr ERR_LINES 1
+  ERR_REGEX "^prizma-render: error: merge: the shards leave a gap in the sample range: samples 4:6 are missing"
+  FIXTURES_REQUIRED render_shards)
+prizma_render_e2e(merge_names_files "merge|shard0.exr|shard1.exr|shard0.exr|-o|named.exr" EXPECT_RC 2
+  MUST_NOT_EXIST named.exr ERR_LINES 1
+  ERR_REGEX "^prizma-render: error: shard0.exr: samples 0:2 overlap samples 0:2 of shard0.exr"
+  FIXTURES_REQUIRED render_shards)
+prizma_render_e2e(merge_one_shard "merge|shard1.exr|-o|one.exr" MUST_EXIST one.exr
+  ERR_REGEX "merged 1 shard, samples 2:4" FIXTURES_REQUIRED render_shards)
+prizma_render_e2e(resume_huge_spp "--resume|shard0.exr|--spp|18446744073709551613|-o|huge.exr" EXPECT_RC 2
+  MUST_NOT_EXIST huge.exr ERR_LINES 1
+  ERR_REGEX "^prizma-render: error: --spp: must be a whole number of samples per pixel from 1 to 2\\^40 \\(1099511627776\\), got \"18446744073709551613\""
+  FIXTURES_REQUIRED render_shards)
