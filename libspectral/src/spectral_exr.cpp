@@ -260,7 +260,7 @@ void check_exr_bin_names(const BinLayout& bins, const std::string& input) {
     const std::string a = spectral_channel_name(bins.centre_nm(i - 1));
     if (a == spectral_channel_name(bins.centre_nm(i))) {
       std::ostringstream os;
-      os.precision(17);
+      os.precision(12);
       os << "bins " << i - 1 << " and " << i << " (centres " << bins.centre_nm(i - 1) << " and " << bins.centre_nm(i)
          << " nm) both get the channel name " << a
          << ": channel names hold the centre to 6 decimals, so bins must be wider";
