@@ -125,12 +125,7 @@ inline bool load_bench_scene(const std::string& name, render::Scene& out, std::s
 // Writes a text file atomically, creating its folder.
 inline void write_text(const fs::path& path, const std::string& text) {
   if (path.has_parent_path()) fs::create_directories(path.parent_path());
-  spectral::write_atomically(path, [&](const fs::path& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    f << text;
-    f.close();
-    if (!f) throw spectral::RuntimeError("cannot write " + tmp.string());
-  });
+  spectral::write_file_atomically(path, text);
 }
 
 // FNV-1a of a string, hex: cache keys.

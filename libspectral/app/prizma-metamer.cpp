@@ -230,19 +230,14 @@ int run_weights(const WeightsCommand& cmd, const CommonOptions& common) {
   const ps::Spectrum light = parse_option(cmd.light, "--light");
   const Eigen::Matrix<double, 3, Eigen::Dynamic> w =
       ps::relight_weights(ps::ColorMatching::get(colour.observer), light, colour.bins);
-  ps::write_atomically(cmd.output, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw ps::RuntimeError(tmp.string() + ": cannot open for writing");
+  std::string text = "lo_nm,hi_nm,X,Y,Z\n";
+  for (int i = 0; i < colour.bins.size(); ++i) {
     char line[160];
-    out << "lo_nm,hi_nm,X,Y,Z\n";
-    for (int i = 0; i < colour.bins.size(); ++i) {
-      std::snprintf(line, sizeof line, "%.9g,%.9g,%.17g,%.17g,%.17g\n", colour.bins.lo_nm(i), colour.bins.hi_nm(i),
-                    w(0, i), w(1, i), w(2, i));
-      out << line;
-    }
-    out.close();
-    if (!out) throw ps::RuntimeError(tmp.string() + ": write failed");
-  });
+    std::snprintf(line, sizeof line, "%.9g,%.9g,%.17g,%.17g,%.17g\n", colour.bins.lo_nm(i), colour.bins.hi_nm(i),
+                  w(0, i), w(1, i), w(2, i));
+    text += line;
+  }
+  ps::write_file_atomically(cmd.output, text);
   return ps::kExitOk;
 }
 
@@ -331,6 +326,9 @@ int main(int argc, char** argv) {
 
   if (const int code = ps::parse_command_line(app, argc, argv); code >= 0) return code;
   return ps::run_tool(program, [&]() {
+    // Only the chosen subcommand's output is set; refuse an unwritable one before any work.
+    for (const std::string* out : {&metamer.output, &light.output, &tabulate.output, &weights.output})
+      if (!out->empty()) ps::check_output_file(*out, "--output");
     if (*sub_metamer) return run_metamer(metamer, common);
     if (*sub_light) return run_light(light, common);
     if (*sub_tabulate) return run_tabulate(tabulate);

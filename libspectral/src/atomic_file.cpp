@@ -1,15 +1,20 @@
-// Atomic output: write a temporary beside the destination, flush it to disk, rename it over the
-// destination. POSIX rename() within one folder is atomic, so readers see the old file or the new one.
+// Outputs: checked before the work, written through a temporary whose every write, fsync and close
+// is checked, renamed over the destination only when complete. POSIX rename() within one folder is
+// atomic, so readers see the old file or the new one, never a part.
 #include "prizma/spectral/atomic_file.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <climits>
 #include <cstring>
+#include <map>
 #include <string>
 #include <system_error>
+#include <tuple>
 
 #include "prizma/spectral/error.h"
 
@@ -21,14 +26,142 @@ namespace fs = std::filesystem;
 std::atomic<unsigned long> g_counter{0};
 
 std::string quoted(const fs::path& p) { return "\"" + p.string() + "\""; }
+std::string errno_text(int err) { return std::strerror(err); }
 
-// Best-effort fsync of a file or folder; failures are ignored (some file systems refuse fsync on
-// folders), the rename is what makes the write atomic.
-void sync_path(const fs::path& p, bool is_dir) {
-  const int fd = ::open(p.c_str(), is_dir ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);
-  if (fd < 0) return;
-  (void)::fsync(fd);
-  (void)::close(fd);
+// The longest file name the folder's file system takes (NAME_MAX, 255 on Linux file systems).
+std::size_t name_max(const fs::path& folder) {
+  errno = 0;
+  const long n = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+  return n > 0 ? static_cast<std::size_t>(n) : 255;
+}
+
+// Room kept for the temporary's folder part of the path beyond the destination's.
+constexpr std::size_t kPathMax = PATH_MAX;
+
+// What resolve() found wrong: `input` problems are the path itself (exit 2 in every case); folder
+// problems found at write time are run-time failures (the folder was fine when the run began).
+struct Resolved {
+  OutputTarget target;
+  fs::path folder;
+  std::string problem;  // empty when the path can be written
+  bool folder_problem = false;
+};
+
+const char* kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+Resolved resolve(const fs::path& path) {
+  Resolved r;
+  const std::string p = quoted(path);
+  if (path.empty()) {
+    r.problem = "empty file name";
+    return r;
+  }
+  if (!path.has_filename()) {
+    r.problem = p + " is not a file name (it ends in '/')";
+    return r;
+  }
+  r.target.file = path;
+  const auto name_too_long = [&](const fs::path& file, const fs::path& folder) {
+    const std::size_t name_len = file.filename().string().size();
+    const std::size_t limit = name_max(folder);
+    if (name_len <= limit) return false;
+    r.problem = "the file name of " + p + " is " + std::to_string(name_len) + " bytes long; this file system allows " +
+                std::to_string(limit);
+    return true;
+  };
+  if (name_too_long(path, path.parent_path().empty() ? fs::path(".") : path.parent_path())) return r;
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) == 0) {
+    if (S_ISLNK(st.st_mode)) {
+      // A symbolic link: its final target is the file replaced, the link stays a link.
+      if (::stat(path.c_str(), &st) != 0) {
+        const int err = errno;
+        std::error_code ec;
+        const fs::path to = fs::read_symlink(path, ec);
+        if (err == ENOENT) {
+          r.problem = p + " is a symbolic link to a file that does not exist (" + quoted(to) +
+                      "); give the file's own path, or remove the link";
+        } else if (err == ELOOP) {
+          r.problem = p + ": too many levels of symbolic links";
+        } else {
+          r.problem = p + ": cannot follow the symbolic link (" + errno_text(err) + ")";
+        }
+        return r;
+      }
+      std::error_code ec;
+      r.target.file = fs::canonical(path, ec);
+      if (ec) {
+        r.problem = p + ": cannot follow the symbolic link (" + ec.message() + ")";
+        return r;
+      }
+    }
+    if (!S_ISREG(st.st_mode)) {
+      r.problem = p + " is " + kind_of(st.st_mode) + "; an output must be a regular file";
+      return r;
+    }
+    r.target.exists = true;
+    r.target.device = st.st_dev;
+    r.target.inode = st.st_ino;
+  } else if (errno == ELOOP) {
+    r.problem = p + ": too many levels of symbolic links";
+    return r;
+  } else if (errno == ENOTDIR) {
+    r.problem = "a part of " + p + " is not a folder";
+    return r;
+  } else if (errno == ENAMETOOLONG) {
+    r.problem = p + " is too long a path for this system";
+    return r;
+  } else if (errno != ENOENT) {
+    const int err = errno;
+    r.folder = r.target.file.parent_path().empty() ? fs::path(".") : r.target.file.parent_path();
+    r.problem = "folder " + quoted(r.folder) + " of " + p + " is not accessible (" + errno_text(err) + ")";
+    r.folder_problem = true;
+    return r;
+  }
+
+  // The folder the temporary goes into: it must exist and be writable.
+  r.folder = r.target.file.parent_path().empty() ? fs::path(".") : r.target.file.parent_path();
+  struct stat dst {};
+  if (::stat(r.folder.c_str(), &dst) != 0 || !S_ISDIR(dst.st_mode)) {
+    r.problem = "folder " + quoted(r.folder) + " of " + p + " does not exist";
+    r.folder_problem = true;
+    return r;
+  }
+  if (::access(r.folder.c_str(), W_OK | X_OK) != 0) {
+    const int err = errno;
+    r.problem = "folder " + quoted(r.folder) + " of " + p + " is not writable (" + errno_text(err) + ")";
+    r.folder_problem = true;
+    return r;
+  }
+  if (!r.target.exists) {
+    r.target.device = dst.st_dev;
+    r.target.inode = dst.st_ino;
+  }
+  if (name_too_long(r.target.file, r.folder)) return r;
+  if ((r.folder / r.target.file.filename()).string().size() + 64 >= kPathMax) {
+    r.problem = p + " is too long a path for this system";
+    return r;
+  }
+  return r;
+}
+
+// ".prizma-tmp-<pid>-<n>-<name>", keeping the tail of the name (its extension) when the whole would
+// be longer than the file system allows.
+std::string temporary_name(const std::string& name, std::size_t limit) {
+  const std::string prefix =
+      ".prizma-tmp-" + std::to_string(::getpid()) + "-" + std::to_string(g_counter.fetch_add(1)) + "-";
+  if (prefix.size() + name.size() <= limit) return prefix + name;
+  std::size_t cut = name.size() - (limit - prefix.size());
+  // Do not cut a UTF-8 sequence in two.
+  while (cut < name.size() && (static_cast<unsigned char>(name[cut]) & 0xC0) == 0x80) ++cut;
+  return prefix + name.substr(cut);
 }
 
 void remove_quietly(const fs::path& p) {
@@ -38,45 +171,222 @@ void remove_quietly(const fs::path& p) {
 
 }  // namespace
 
-void write_atomically(const fs::path& path, const std::function<void(const fs::path& tmp_path)>& write) {
-  if (path.empty()) throw RuntimeError("cannot write a file with an empty path");
-  if (!path.has_filename()) throw RuntimeError(quoted(path) + ": not a file name");
-  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+OutputTarget check_output_file(const fs::path& path, const std::string& input) {
+  Resolved r = resolve(path);
+  if (!r.problem.empty()) throw InputError(input, r.problem);
+  return r.target;
+}
 
-  // The folder must exist and be writable: say so clearly instead of letting the writer fail obscurely.
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) {
-    throw RuntimeError(quoted(path) + ": cannot write: folder " + quoted(dir) + " does not exist");
+void check_distinct_outputs(const std::vector<std::pair<fs::path, std::string>>& outputs) {
+  // Identity: an existing file by (device, inode); a new one by its folder's and its name.
+  using Key = std::tuple<bool, dev_t, ino_t, std::string>;
+  std::map<Key, std::size_t> seen;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [path, input] = outputs[i];
+    const OutputTarget t = check_output_file(path, input);
+    const Key key{t.exists, t.device, t.inode, t.exists ? std::string() : t.file.filename().string()};
+    const auto [it, inserted] = seen.emplace(key, i);
+    if (!inserted) {
+      const auto& [first_path, first_input] = outputs[it->second];
+      throw InputError(input, quoted(path) + " is the same file as " + first_input + " (" + quoted(first_path) +
+                                  "): one run cannot write two outputs into one file");
+    }
   }
-  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
-    throw RuntimeError(quoted(path) + ": cannot write: folder " + quoted(dir) +
-                       " is not writable (" + std::strerror(errno) + ")");
-  }
-  if (fs::is_directory(path, ec)) {
-    throw RuntimeError(quoted(path) + ": cannot write: it is a folder");
-  }
+}
 
-  const std::string tmp_name = ".prizma-tmp-" + std::to_string(::getpid()) + "-" +
-                               std::to_string(g_counter.fetch_add(1)) + "-" + path.filename().string();
-  const fs::path tmp = dir / tmp_name;
+// ---------------------------------------------------------------------------------------------
+// AtomicOutput
 
+AtomicOutput::AtomicOutput(int fd, fs::path destination, fs::path temporary)
+    : m_fd(fd), m_destination(std::move(destination)), m_temporary(std::move(temporary)) {}
+
+void AtomicOutput::record(const std::string& reason) noexcept {
+  if (!m_error.empty()) return;
   try {
-    write(tmp);
+    m_error = reason.empty() ? std::string("write failed") : reason;
   } catch (...) {
+    // Out of memory while recording: keep a fixed reason (the string is empty, SSO fits it).
+    m_error = "write failed";
+  }
+}
+
+bool AtomicOutput::write_all_at(const void* data, std::size_t n, std::int64_t offset) noexcept {
+  if (!m_error.empty()) return false;
+  if (offset < 0) {
+    record("negative file position");
+    return false;
+  }
+  const char* bytes = static_cast<const char*>(data);
+  std::size_t done = 0;
+  while (done < n) {
+    const ssize_t w = ::pwrite(m_fd, bytes + done, n - done, static_cast<off_t>(offset) + static_cast<off_t>(done));
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      record(errno_text(errno));
+      return false;
+    }
+    if (w == 0) {
+      record(errno_text(ENOSPC));
+      return false;
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  if (offset + static_cast<std::int64_t>(n) > m_size) m_size = offset + static_cast<std::int64_t>(n);
+  return true;
+}
+
+bool AtomicOutput::write(const void* data, std::size_t n) noexcept {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  if (!write_all_at(data, n, m_pos)) return false;
+  m_pos += static_cast<std::int64_t>(n);
+  return true;
+}
+
+bool AtomicOutput::write_at(const void* data, std::size_t n, std::int64_t offset) noexcept {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  return write_all_at(data, n, offset);
+}
+
+std::size_t AtomicOutput::read_at(void* data, std::size_t n, std::int64_t offset) noexcept {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  if (!m_error.empty() || offset < 0) return 0;
+  char* bytes = static_cast<char*>(data);
+  std::size_t done = 0;
+  while (done < n) {
+    const ssize_t r = ::pread(m_fd, bytes + done, n - done, static_cast<off_t>(offset) + static_cast<off_t>(done));
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) break;
+    done += static_cast<std::size_t>(r);
+  }
+  return done;
+}
+
+bool AtomicOutput::seek(std::int64_t offset) noexcept {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  if (!m_error.empty()) return false;
+  if (offset < 0) {
+    record("seek to a negative file position");
+    return false;
+  }
+  m_pos = offset;
+  return true;
+}
+
+std::int64_t AtomicOutput::tell() const noexcept {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  return m_pos;
+}
+
+std::int64_t AtomicOutput::size() const noexcept {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  return m_size;
+}
+
+void AtomicOutput::fail(const std::string& reason) noexcept {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  record(reason);
+}
+
+bool AtomicOutput::failed() const noexcept {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  return !m_error.empty();
+}
+
+std::string AtomicOutput::error() const {
+  const std::lock_guard<std::mutex> lock(m_mutex);
+  return m_error;
+}
+
+// ---------------------------------------------------------------------------------------------
+// write_atomically
+
+void write_atomically(const fs::path& path, const std::function<void(AtomicOutput& out)>& write) {
+  const Resolved r = resolve(path);
+  if (!r.problem.empty()) {
+    if (r.folder_problem) throw RuntimeError(path.string() + ": cannot write: " + r.problem);
+    throw InputError(path.string(), r.problem);
+  }
+  const bool existed = r.target.exists;
+  const auto failure = [&](const std::string& reason) {
+    return RuntimeError(path.string() + ": cannot write: " + reason +
+                        (existed ? " (the existing file is unchanged)" : ""));
+  };
+
+  const fs::path tmp = r.folder / temporary_name(r.target.file.filename().string(), name_max(r.folder));
+  const int fd = ::open(tmp.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    const int err = errno;
+    throw failure("cannot create the temporary " + quoted(tmp) + " (" + errno_text(err) + ")");
+  }
+  bool fd_open = true;
+  const auto abandon = [&] {
+    if (fd_open) (void)::close(fd);
+    fd_open = false;
     remove_quietly(tmp);
+  };
+
+  AtomicOutput out(fd, path, tmp);
+  try {
+    // A replaced file keeps its permissions.
+    struct stat old {};
+    if (existed && ::stat(r.target.file.c_str(), &old) == 0 && ::fchmod(fd, old.st_mode & 07777) != 0) {
+      const int err = errno;
+      out.fail("cannot set the permissions of the temporary (" + errno_text(err) + ")");
+    }
+    if (!out.failed()) write(out);
+  } catch (...) {
+    abandon();
+    if (out.failed()) throw failure(out.error());  // the write's own failure is the cause
     throw;
   }
 
-  if (!fs::exists(tmp, ec)) {
-    throw RuntimeError(quoted(path) + ": the writer did not create the temporary file " + quoted(tmp));
+  // Complete? Every write succeeded, the file holds exactly what was written, and it is on disk.
+  std::string problem = out.error();
+  if (problem.empty() && out.size() == 0) problem = "nothing was written";
+  struct stat st {};
+  if (problem.empty()) {
+    if (::fstat(fd, &st) != 0) {
+      const int err = errno;
+      problem = "cannot check the temporary (" + errno_text(err) + ")";
+    } else if (st.st_size != static_cast<off_t>(out.size())) {
+      problem = "the temporary holds " + std::to_string(st.st_size) + " bytes, " + std::to_string(out.size()) +
+                " were written";
+    }
   }
-  sync_path(tmp, false);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
-    remove_quietly(tmp);
-    throw RuntimeError(quoted(path) + ": cannot rename " + quoted(tmp) + " into place (" + reason + ")");
+  if (problem.empty() && ::fsync(fd) != 0) {
+    const int err = errno;
+    problem = "cannot flush to disk (" + errno_text(err) + ")";
   }
-  sync_path(dir, true);
+  if (problem.empty()) {
+    fd_open = false;
+    if (::close(fd) != 0) problem = errno_text(errno);
+  }
+  if (!problem.empty()) {
+    abandon();
+    throw failure(problem);
+  }
+
+  if (::rename(tmp.c_str(), r.target.file.c_str()) != 0) {
+    const std::string reason = errno_text(errno);
+    abandon();
+    throw failure("cannot rename " + quoted(tmp) + " into place (" + reason + ")");
+  }
+
+  // The rename itself on disk: fsync the folder (file systems that cannot sync a folder say EINVAL).
+  const int dfd = ::open(r.folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    const int rc = ::fsync(dfd);
+    const int err = errno;
+    (void)::close(dfd);
+    if (rc != 0 && err != EINVAL && err != ENOTSUP && err != EROFS) {
+      throw RuntimeError(path.string() + ": written, but its folder " + quoted(r.folder) +
+                         " could not be flushed to disk (" + errno_text(err) + ")");
+    }
+  }
+}
+
+void write_file_atomically(const fs::path& path, std::string_view content) {
+  write_atomically(path, [&](AtomicOutput& out) { out.write(content); });
 }
 
 }  // namespace prizma::spectral

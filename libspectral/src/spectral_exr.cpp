@@ -199,6 +199,23 @@ std::uint64_t layer_hash(const Value* v, std::size_t n, std::uint64_t basis) {
   return h;
 }
 
+// OpenEXR's output stream over write_atomically's checked temporary: a failed write throws (OpenEXR
+// is C++), and AtomicOutput keeps the system's reason for the message.
+class AtomicOStream final : public Imf::OStream {
+ public:
+  explicit AtomicOStream(AtomicOutput& out) : Imf::OStream(out.temporary().c_str()), m_out(out) {}
+  void write(const char c[], int n) override {
+    if (n < 0 || !m_out.write(c, static_cast<std::size_t>(n))) throw RuntimeError(m_out.error());
+  }
+  uint64_t tellp() override { return static_cast<uint64_t>(m_out.tell()); }
+  void seekp(uint64_t pos) override {
+    if (!m_out.seek(static_cast<std::int64_t>(pos))) throw RuntimeError(m_out.error());
+  }
+
+ private:
+  AtomicOutput& m_out;
+};
+
 std::string checksum_string(std::uint64_t sum) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(sum));
@@ -231,6 +248,29 @@ std::string spectral_channel_name(double lambda_nm, std::string_view layer) {
   return layer_prefix(layer) + "T." + number + "nm";
 }
 
+void check_exr_light_name(std::string_view name, const std::string& input) {
+  if (!valid_light_name(name)) {
+    throw InputError(input, "light name \"" + std::string(name) + "\" is not valid (letters, digits, '_' and '-' only)");
+  }
+  if (name == kVarianceLayer) {
+    throw InputError(input, "light name \"var\" is reserved for the variance layers (docs/spectral-exr.md)");
+  }
+}
+
+void check_exr_bin_names(const BinLayout& bins, const std::string& input) {
+  for (int i = 1; i < bins.size(); ++i) {
+    const std::string a = spectral_channel_name(bins.centre_nm(i - 1));
+    if (a == spectral_channel_name(bins.centre_nm(i))) {
+      std::ostringstream os;
+      os.precision(12);
+      os << "bins " << i - 1 << " and " << i << " (centres " << bins.centre_nm(i - 1) << " and " << bins.centre_nm(i)
+         << " nm) both get the channel name " << a
+         << ": channel names hold the centre to 6 decimals, so bins must be wider";
+      throw InputError(input, os.str());
+    }
+  }
+}
+
 void write_spectral_exr(const fs::path& path, const SpectralImage& image, const ExrWriteOptions& opts) {
   const std::string p = path_string(path);
   // Validate the image: sizes, names, finite values.
@@ -243,12 +283,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   const std::size_t expected = image.pixel_count() * static_cast<std::size_t>(bins);
   std::set<std::string> names;
   for (const auto& light : image.lights) {
-    if (!valid_light_name(light.name)) {
-      throw InputError(p, "light name \"" + light.name + "\" is not valid (letters, digits, '_' and '-' only)");
-    }
-    if (light.name == kVarianceLayer) {
-      throw InputError(p, "light name \"var\" is reserved for variance layers");
-    }
+    check_exr_light_name(light.name, p);
     if (!names.insert(light.name).second) throw InputError(p, "two lights are named \"" + light.name + "\"");
     if (light.data.size() != expected) {
       throw InputError(p, "light \"" + light.name + "\" has " + std::to_string(light.data.size()) +
@@ -297,9 +332,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   // Channel names, refusing two bins whose centres print the same.
   std::vector<std::string> suffixes;
   for (int i = 0; i < bins; ++i) suffixes.push_back(spectral_channel_name(image.bins.centre_nm(i)));
-  for (int i = 1; i < bins; ++i) {
-    if (suffixes[i] == suffixes[i - 1]) throw InputError(p, "two bins share the channel name " + suffixes[i]);
-  }
+  check_exr_bin_names(image.bins, p);
 
   // Half: refuse (or clamp) values beyond half's range, then convert.
   const bool half_out = opts.pixel_type == ExrPixelType::Half;
@@ -393,9 +426,10 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
     }
   }
 
-  write_atomically(path, [&](const fs::path& tmp) {
+  write_atomically(path, [&](AtomicOutput& out) {
     try {
-      Imf::OutputFile file(tmp.c_str(), header, io_threads());
+      AtomicOStream stream(out);
+      Imf::OutputFile file(stream, header, io_threads());
       file.setFrameBuffer(fb);
       file.writePixels(image.height);
     } catch (const InputError&) {

@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <sstream>
 
 #include "csv_table.h"
 #include "prizma/spectral/atomic_file.h"
@@ -341,14 +342,10 @@ void write_spectrum_csv(const std::filesystem::path& path, const Spectrum& s, st
     lam = {BinLayout::kMinNm, BinLayout::kMaxNm};
     val = {s.eval(BinLayout::kMinNm), s.eval(BinLayout::kMaxNm)};
   }
-  write_atomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw RuntimeError(tmp.string() + ": cannot open for writing");
-    out << "wavelength_nm," << value_name << "\n";
-    for (std::size_t i = 0; i < lam.size(); ++i) out << format_double(lam[i]) << "," << format_double(val[i]) << "\n";
-    out.close();
-    if (!out) throw RuntimeError(tmp.string() + ": write failed");
-  });
+  std::ostringstream text;
+  text << "wavelength_nm," << value_name << "\n";
+  for (std::size_t i = 0; i < lam.size(); ++i) text << format_double(lam[i]) << "," << format_double(val[i]) << "\n";
+  write_file_atomically(path, text.str());
 }
 
 }  // namespace prizma::spectral

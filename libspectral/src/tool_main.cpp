@@ -1,5 +1,9 @@
 #include "prizma/spectral/tool_main.h"
 
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -23,9 +27,26 @@ std::string prizma_version() {
   return v;
 }
 
+int check_standard_output(const std::string& program, int rc) {
+  // std::cout is synchronised with stdio (the default), so both end in stdout's buffer; flush it
+  // first, while the reason of a failure is still in errno.
+  errno = 0;
+  const bool flush_failed = std::fflush(stdout) != 0;
+  const int err = errno;
+  std::cout.flush();
+  if (!flush_failed && !std::ferror(stdout) && std::cout.good()) return rc;
+  if (rc != kExitOk) return rc;  // the run already failed and said why
+  std::cerr << program << ": error: standard output: cannot write"
+            << (flush_failed && err != 0 ? std::string(": ") + std::strerror(err) : std::string()) << "\n";
+  return kExitRuntime;
+}
+
 int run_tool(const std::string& program, const std::function<int()>& body) {
+  // A file-size limit (ulimit -f) makes a write fail with EFBIG, reported like any failed write,
+  // instead of killing the process with SIGXFSZ.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
-    return body();
+    return check_standard_output(program, body());
   } catch (const InputError& e) {
     std::cerr << program << ": error: " << e.what() << "\n";
     return kExitUsage;

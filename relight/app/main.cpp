@@ -17,6 +17,7 @@
 #include "prizma/relight/relight_session.h"
 #include "prizma/relight/terminal_image.h"
 #include "prizma/relight/terminal_preview.h"
+#include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/data_path.h"
@@ -128,9 +129,18 @@ int run(const CliOptions& o) {
     for (std::string line; std::getline(lights, line);) std::cerr << "prizma-relight: light " << line << "\n";
   }
 
-  if (!o.batch.empty()) {
-    const auto outputs = relight::read_batch_file(o.batch, session, session.settings());
-    relight::run_batch(session, outputs, o.verbose ? &std::cerr : nullptr);
+  std::vector<relight::BatchOutput> batch;
+  if (!o.batch.empty()) batch = relight::read_batch_file(o.batch, session, session.settings());
+  {  // Every output of the run is a different file (one would overwrite another).
+    std::vector<std::pair<std::filesystem::path, std::string>> outputs;
+    if (!o.output.empty()) outputs.emplace_back(o.output, "--output");
+    if (!o.preview.empty()) outputs.emplace_back(o.preview, "--preview");
+    for (std::size_t i = 0; i < batch.size(); ++i)
+      outputs.emplace_back(batch[i].file, o.batch + ": outputs[" + std::to_string(i) + "].file");
+    spectral::check_distinct_outputs(outputs);
+  }
+  if (!batch.empty()) {
+    relight::run_batch(session, batch, o.verbose ? &std::cerr : nullptr);
     session.apply(cli_settings);
   }
   if (!o.output.empty()) {

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "prizma/relight/relight_image.h"
+#include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
 
 namespace prizma::relight {
@@ -99,7 +100,7 @@ std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSess
   }
 
   std::vector<BatchOutput> outputs;
-  std::set<fs::path> seen;
+  std::vector<std::pair<fs::path, std::string>> files;  // (file, input naming it)
   const json& list = doc["outputs"];
   for (std::size_t i = 0; i < list.size(); ++i) {
     const std::string where = name + ": outputs[" + std::to_string(i) + "]";
@@ -111,9 +112,6 @@ std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSess
     BatchOutput out;
     const fs::path file = entry["file"].get<std::string>();
     out.file = file.is_absolute() ? file : base_dir / file;
-    if (!seen.insert(fs::weakly_canonical(out.file)).second) {
-      throw InputError(where + ".file", "\"" + file.string() + "\" is written by an earlier output too");
-    }
     out.settings = defaults;
     apply_keys(entry, where, session, base_dir, out.settings);
     // Validate now so that a bad entry stops the batch before anything is written.
@@ -125,8 +123,11 @@ std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSess
     } catch (const InputError& e) {
       throw InputError(where, e.what());
     }
+    files.emplace_back(out.file, where + ".file");
     outputs.push_back(std::move(out));
   }
+  // Two entries writing one file ("a.png" and "./a.png", links to one file) would lose one image.
+  spectral::check_distinct_outputs(files);
   return outputs;
 }
 

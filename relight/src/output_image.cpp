@@ -1,7 +1,5 @@
 #include "prizma/relight/output_image.h"
 
-#include <unistd.h>
-
 #include <OpenImageIO/imageio.h>
 #include <algorithm>
 #include <cctype>
@@ -10,6 +8,7 @@
 
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/oiio_atomic_output.h"
 
 namespace prizma::relight {
 
@@ -27,15 +26,7 @@ OutputFormat output_format_for(const fs::path& path, const std::string& input) {
 
 void check_output_path(const fs::path& path, const std::string& input) {
   output_format_for(path, input);
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw InputError(input, "\"" + path.string() + "\" is a folder");
-  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  if (!fs::is_directory(folder, ec)) {
-    throw InputError(input, "folder \"" + folder.string() + "\" of \"" + path.string() + "\" does not exist");
-  }
-  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
-    throw InputError(input, "folder \"" + folder.string() + "\" of \"" + path.string() + "\" is not writable");
-  }
+  spectral::check_output_file(path, input);
 }
 
 bool needs_transform(OutputFormat format, const OutputOptions& opts) {
@@ -94,18 +85,8 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
   if (format == OutputFormat::Exr) spec.attribute("compression", "zip");
   for (const auto& [key, value] : metadata) spec.attribute(key, value);
 
-  spectral::write_atomically(path, [&](const fs::path& tmp) {
-    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(tmp.string());
-    if (!out) throw spectral::RuntimeError(path.string() + ": cannot create writer: " + OIIO::geterror());
-    if (!out->open(tmp.string(), spec)) {
-      throw spectral::RuntimeError(path.string() + ": " + out->geterror());
-    }
-    if (!out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) {
-      const std::string err = out->geterror();
-      out->close();
-      throw spectral::RuntimeError(path.string() + ": " + err);
-    }
-    if (!out->close()) throw spectral::RuntimeError(path.string() + ": " + out->geterror());
+  spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {
+    spectral::write_oiio_image(out, spec, OIIO::TypeDesc::FLOAT, pixels.data());
   });
 }
 

@@ -17,6 +17,7 @@
 #include "prizma/render/resume.h"
 #include "prizma/render/sample_range.h"
 #include "prizma/render/scene.h"
+#include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectral_exr.h"
@@ -75,13 +76,16 @@ struct Options {
   bool verbose = false;
 };
 
-// Refuses before rendering when the output's folder is missing or not writable.
-void check_writable(const std::filesystem::path& path, const std::string& input) {
-  std::filesystem::path dir = path.parent_path();
-  if (dir.empty()) dir = ".";
-  if (!std::filesystem::is_directory(dir))
-    throw InputError(input, "folder " + dir.string() + " does not exist");
-  if (::access(dir.c_str(), W_OK) != 0) throw InputError(input, "folder " + dir.string() + " is not writable");
+// Refuses before any work outputs that cannot be written (spectral::check_output_file: a folder, a
+// device, a FIFO, a missing or read-only folder, …), a preview in a format that cannot be written,
+// and a preview that is the same file as the output.
+void check_outputs(const std::filesystem::path& output, const std::string& output_input, const std::string& preview) {
+  std::vector<std::pair<std::filesystem::path, std::string>> outputs{{output, output_input}};
+  if (!preview.empty()) {
+    render::check_preview_path(preview, "--preview");
+    outputs.emplace_back(preview, "--preview");
+  }
+  spectral::check_distinct_outputs(outputs);
 }
 
 class ProgressBar {
@@ -148,7 +152,7 @@ int merge_main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
   if (const int rc = spectral::parse_command_line(app, argc - 1, argv + 1); rc >= 0) return rc;
   return spectral::run_tool(kProgram, [&] {
-    check_writable(output, "-o");
+    check_outputs(output, "-o", preview);
     std::vector<spectral::SpectralImage> shards;
     for (const auto& f : inputs) shards.push_back(spectral::read_spectral_exr(f));
     const auto merged = render::merge_shards(shards, inputs);
@@ -240,7 +244,7 @@ int main(int argc, char** argv) {
         return spectral::kExitOk;
       }
       if (plan.complete) {
-        check_writable(o.output, "-o");
+        check_outputs(o.output, "-o", o.preview);
         plan.previous.info.render_options = render::overrides_to_json(plan.overrides);
         write_outputs(plan.previous, o.output, plan.overrides.half, o.preview, plan.scene.lights,
                       plan.scene.source.parent_path());
@@ -266,8 +270,7 @@ int main(int argc, char** argv) {
     std::filesystem::path output = o.output;
     if (output.empty()) output = o.resume.empty() ? scene.output : std::filesystem::path(o.resume);
     if (output.empty()) throw InputError("-o", "no output file: give -o or set \"output\" in the scene");
-    check_writable(output, "-o");
-    if (!o.preview.empty()) check_writable(o.preview, "--preview");
+    check_outputs(output, !o.output.empty() ? "-o" : !o.resume.empty() ? "--resume" : o.scene + ": output", o.preview);
 
     std::optional<tbb::global_control> threads;
     if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);

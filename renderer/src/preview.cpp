@@ -9,6 +9,7 @@
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/light_spectrum.h"
+#include "prizma/spectral/oiio_atomic_output.h"
 
 namespace prizma::render {
 
@@ -42,13 +43,18 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
       rgb8[p * 3 + c] = static_cast<unsigned char>(std::lround(e * 255.0));
     }
   }
-  spectral::write_atomically(path, [&](const std::filesystem::path& tmp) {
-    auto out = OIIO::ImageOutput::create(tmp.string());
-    if (!out) throw spectral::RuntimeError(path.string() + ": cannot write this format: " + OIIO::geterror());
-    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-    if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb8.data()) || !out->close())
-      throw spectral::RuntimeError(path.string() + ": " + out->geterror());
+  const OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {
+    spectral::write_oiio_image(out, spec, OIIO::TypeDesc::UINT8, rgb8.data());
   });
+}
+
+void check_preview_path(const std::filesystem::path& path, const std::string& input) {
+  spectral::check_output_file(path, input);
+  if (!OIIO::ImageOutput::create(path.string())) {
+    throw spectral::InputError(input, "\"" + path.string() + "\": cannot write this image format (" +
+                                          OIIO::geterror() + "); use .png");
+  }
 }
 
 }  // namespace prizma::render

@@ -6,6 +6,7 @@
 
 #include "prizma/render/render.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/spectral_exr.h"
 
 namespace prizma::render {
 namespace {
@@ -21,7 +22,10 @@ void apply_overrides(Scene& scene, const RenderOverrides& o, const std::string& 
   auto& st = scene.settings;
   if (o.width) scene.camera.width = *o.width;
   if (o.height) scene.camera.height = *o.height;
-  if (o.bins) st.bins = spectral::BinLayout::parse(*o.bins, input_prefix + "bins");
+  if (o.bins) {
+    st.bins = spectral::BinLayout::parse(*o.bins, input_prefix + "bins");
+    spectral::check_exr_bin_names(st.bins, input_prefix + "bins");
+  }
   if (o.seed) st.seed = *o.seed;
   if (o.wavelength_sampling)
     st.wavelength_sampling = parse_wavelength_sampling(*o.wavelength_sampling, input_prefix + "wavelength-sampling");

@@ -13,6 +13,7 @@
 #include "prizma/render/transfer_function.h"
 #include "prizma/render/volume.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/spectrum_spec.h"
 
 namespace prizma::render {
@@ -435,6 +436,7 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
         rd.fail(np, "may hold only letters, digits, '_' and '-' (got \"" + l.name + "\")");
       }
     }
+    spectral::check_exr_light_name(l.name, rd.input(np));  // "var" names the variance layers
     if (!names.insert(l.name).second) rd.fail(np, "duplicate light name \"" + l.name + "\"");
     const std::string dp = Reader::join(lp, "direction");
     if (!lj.contains("direction")) rd.fail(dp, "is required ([0, 0, 0] = uniform environment)");
@@ -465,6 +467,7 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
 void read_settings(const Reader& rd, const json& root, RenderSettings& s) {
   if (root.contains("bins")) {
     s.bins = spectral::BinLayout::parse(rd.string(root.at("bins"), "bins"), rd.input("bins"));
+    spectral::check_exr_bin_names(s.bins, rd.input("bins"));
   }
   if (root.contains("samples")) s.sample_end = rd.integer(root.at("samples"), "samples", 1, std::int64_t{1} << 40);
   if (root.contains("seed")) {

@@ -16,13 +16,13 @@ inline int parse_command_line(CLI::App& app, int argc, const char* const* argv) 
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
     std::cout << app.help();
-    return kExitOk;
+    return check_standard_output(app.get_name(), kExitOk);
   } catch (const CLI::CallForAllHelp&) {
     std::cout << app.help("", CLI::AppFormatMode::All);
-    return kExitOk;
+    return check_standard_output(app.get_name(), kExitOk);
   } catch (const CLI::CallForVersion&) {
     std::cout << app.get_name() << " " << prizma_version() << "\n";
-    return kExitOk;
+    return check_standard_output(app.get_name(), kExitOk);
   } catch (const CLI::ParseError& e) {
     std::cerr << app.get_name() << ": error: " << e.what() << "\n"
               << "Try '" << app.get_name() << " --help'.\n";

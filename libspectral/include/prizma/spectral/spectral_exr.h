@@ -76,4 +76,10 @@ std::string spectral_pixel_checksum(const SpectralImage& image);
 // "T.550,000000nm" style channel name for a wavelength (six decimals, comma separator).
 std::string spectral_channel_name(double lambda_nm, std::string_view layer = "");
 
+// What write_spectral_exr refuses, checkable before the work that makes the image. A light name
+// must be letters, digits, '_' and '-' and not "var" (the variance layers' name); every bin needs
+// its own channel name (centres that differ in the six decimals). Throw InputError(input, …).
+void check_exr_light_name(std::string_view name, const std::string& input);
+void check_exr_bin_names(const BinLayout& bins, const std::string& input);
+
 }  // namespace prizma::spectral

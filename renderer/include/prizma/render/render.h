@@ -80,6 +80,9 @@ struct PreviewOptions {
 // atomically. Throws InputError for an unknown spectrum spec, RuntimeError for I/O failures.
 void write_preview(const std::filesystem::path& path, const spectral::SpectralImage& image,
                    const std::vector<Light>& lights, const PreviewOptions& opts = {});
+// Checks before rendering that a preview can be written at `path` (spectral::check_output_file and a
+// format OpenImageIO writes); throws InputError(input, …).
+void check_preview_path(const std::filesystem::path& path, const std::string& input);
 
 // "spectral-tracking" / "single", as stored in prizma:wavelengthSampling and taken by the CLI.
 std::string wavelength_sampling_name(WavelengthSampling w);

@@ -1,0 +1,26 @@
+# The output rules of docs/errors.md ("Outputs") through the executables: failed writes (a file-size
+# limit) exit 1 and keep the old file; devices, FIFOs, sockets and folders as outputs are refused
+# before any work; links to files keep the link; two outputs in one file, and what can be checked
+# before rendering, are refused at once; write errors on standard output exit 1.
+# tests/e2e/outputs/check-outputs runs each case (ulimit, mkfifo and sockets need a harness).
+if(NOT TARGET prizma-render OR NOT TARGET prizma-relight OR NOT TARGET prizma-metamer)
+  return()
+endif()
+find_program(PRIZMA_SYSTEM_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT PRIZMA_SYSTEM_PYTHON3)
+  message(STATUS "tests/e2e/outputs.cmake: /usr/bin/python3 not found, output tests skipped")
+  return()
+endif()
+
+set(_outputs_work ${PRIZMA_E2E_WORK}/outputs)
+set(_outputs_cmd ${PRIZMA_SYSTEM_PYTHON3} ${PRIZMA_E2E_DIR}/outputs/check-outputs
+    --render $<TARGET_FILE:prizma-render> --relight $<TARGET_FILE:prizma-relight>
+    --metamer $<TARGET_FILE:prizma-metamer> --scene ${PRIZMA_E2E_DIR}/render/tiny.json --work ${_outputs_work})
+add_test(NAME outputs.e2e.fixture COMMAND ${_outputs_cmd} fixture)
+set_tests_properties(outputs.e2e.fixture PROPERTIES FIXTURES_SETUP outputs_files LABELS outputs
+                     ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+foreach(case fsize_relight fsize_render fsize_metamer special_outputs symlink_outputs same_file prework_render stdout)
+  add_test(NAME outputs.e2e.${case} COMMAND ${_outputs_cmd} ${case})
+  set_tests_properties(outputs.e2e.${case} PROPERTIES FIXTURES_REQUIRED outputs_files LABELS outputs TIMEOUT 300
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+endforeach()
