@@ -288,21 +288,39 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
       }
     }
 
-    // New direction from the phase function. With g varying across lanes: sample one lane's lobe
-    // chosen uniformly (one-sample MIS over lanes), weight each lane by p_i / mean_j p_j.
+    // New direction from the phase function. With g varying across lanes: one-sample MIS over the
+    // lanes' lobes with the balance heuristic (Veach 1997, §9.2.4), the lobe chosen in proportion to
+    // the lanes' current weights, c_j = w_j / W with W = Σ_j w_j. The direction's density is then
+    // q(ω) = Σ_j c_j p_j(ω) and lane i is weighted by p_i(ω) / q(ω):
+    //   w_i' = w_i p_i / q = W · w_i p_i / Σ_j w_j p_j.
+    // Unbiased: c is fixed before ω is drawn and q > 0 wherever any p_i > 0 (HG lobes with |g| < 1
+    // cover the sphere), so E[w_i p_i(ω)/q(ω)] = w_i ∫ p_i = w_i (the phase function's normalisation).
+    // Bounded: the denominator holds the term w_i p_i, so w_i' ≤ W; and Σ_i w_i' = W exactly, so the
+    // sum of the lane weights never changes at a scattering and no lane exceeds it (≤ n · max_j w_j,
+    // the per-lane factor w_i'/w_i ≤ 1/c_i). With uniform c (the previous estimator, factor p_i /
+    // mean_j p_j ≤ n per scattering) the factors multiply along the path without bound.
     float cos_theta;
     if (g_constant) {
       cos_theta = hg_sample_cos(g[0], rng.uniform());
     } else {
-      const int j = std::min(n - 1, static_cast<int>(rng.uniform() * static_cast<float>(n)));
+      float total = 0.0f;
+      for (int i = 0; i < n; ++i) total += w[i];
+      if (!(total > 0.0f)) return;
+      // Lane j with probability w_j / W (inverse CDF; lanes of weight 0 are never chosen).
+      const float target = rng.uniform() * total;
+      int j = 0;
+      float cdf = w[0];
+      while (j < n - 1 && cdf <= target) cdf += w[++j];
+      while (j > 0 && w[j] <= 0.0f) --j;  // float rounding past the end: the last lane that can be chosen
       cos_theta = hg_sample_cos(g[j], rng.uniform());
-      float sum = 0.0f;
+      float mix = 0.0f;  // Σ_j w_j p_j = W · q(ω)
       for (int i = 0; i < n; ++i) {
         f[i] = hg_phase(cos_theta, g[i]);
-        sum += f[i];
+        mix += w[i] * f[i];
       }
-      const float inv_pdf = static_cast<float>(n) / sum;
-      for (int i = 0; i < n; ++i) w[i] *= f[i] * inv_pdf;
+      if (!(mix > 0.0f)) return;
+      const float k = total / mix;
+      for (int i = 0; i < n; ++i) w[i] *= f[i] * k;
     }
     dir = direction_around(dir, cos_theta, rng.uniform_double()).normalized();
 
