@@ -6,6 +6,8 @@
 //   BinCost/<n>                a spectral-tracking path carrying n bins vs a one-wavelength path
 //   AllBinsVsSingle            the default 16 bins, chromatic cube: all-bins path vs VPT's single path
 //   Threads                    render() on 1 vs 2 threads (speed-up)
+//   Interpolation/mri          the MRI scene (data/scenes/mri.json), 16 bins: a path through the
+//                              trilinear, post-classified medium vs the same paths with nearest voxels
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -213,6 +215,48 @@ void threads(benchmark::State& state, const pr::Scene& base) {
   state.counters["speedup_2_threads"] = t1 / t2;
 }
 
+// A path through the trilinear medium vs the nearest-voxel medium of the same scene, interleaved.
+void interpolation(benchmark::State& state, const std::string& name) {
+  pr::Scene tri;
+  std::string why;
+  if (!pb::load_bench_scene(name, tri, why)) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  tri.camera.width = 64;
+  tri.camera.height = 64;
+  pr::Scene near = tri;
+  near.medium.interpolation = pr::Interpolation::Nearest;
+  const ps::BinLayout& bins = tri.settings.bins;
+  const pr::PathTracer ta(tri, bins.min_nm(), bins.max_nm(), true), tb(near, bins.min_nm(), bins.max_nm(), true);
+  pr::PathScratch sa, sb;
+  ta.prepare(sa, bins.size());
+  tb.prepare(sb, bins.size());
+  BatchResult a, b;
+  std::uint64_t seed = 1;
+  for (auto _ : state) {
+    if (seed % 2) {
+      trace_batch(tri, ta, sa, bins, seed, 256, a);
+      trace_batch(near, tb, sb, bins, seed, 256, b);
+    } else {
+      trace_batch(near, tb, sb, bins, seed, 256, b);
+      trace_batch(tri, ta, sa, bins, seed, 256, a);
+    }
+    ++seed;
+  }
+  auto per_path = [](const BatchResult& r) { return r.seconds / static_cast<double>(r.paths) * 1e6; };
+  auto steps = [](const BatchResult& r) {
+    return static_cast<double>(r.counters.collisions + r.counters.shadow_steps) / static_cast<double>(r.paths);
+  };
+  state.counters["trilinear_us_per_path"] = per_path(a);
+  state.counters["nearest_us_per_path"] = per_path(b);
+  state.counters["trilinear_steps_per_path"] = steps(a);
+  state.counters["nearest_steps_per_path"] = steps(b);
+  state.counters["trilinear_ns_per_step"] = a.seconds / (steps(a) * static_cast<double>(a.paths)) * 1e9;
+  state.counters["nearest_ns_per_step"] = b.seconds / (steps(b) * static_cast<double>(b.paths)) * 1e9;
+  state.counters["cost_ratio"] = per_path(a) / per_path(b);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -231,6 +275,8 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark("Threads/cube", [](benchmark::State& s) { threads(s, cube_scene()); })
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();
+  benchmark::RegisterBenchmark("Interpolation/mri", [](benchmark::State& s) { interpolation(s, "mri"); })
+      ->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

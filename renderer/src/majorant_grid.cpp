@@ -19,18 +19,64 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
     m_cell_size[a] = voxel * span[a];
   }
   m_majorant.assign(static_cast<std::size_t>(m_cells[0]) * m_cells[1] * m_cells[2], 0.0f);
-  for (int z = 0; z < d[2]; ++z)
-    for (int y = 0; y < d[1]; ++y)
-      for (int x = 0; x < d[0]; ++x) {
-        const std::size_t v = (static_cast<std::size_t>(z) * d[1] + y) * d[0] + x;
-        const std::uint16_t m = medium.material[v];
-        if (m == Medium::kEmpty) continue;
-        const float mu = medium.density[v] * sigma_t_max[m];
-        float& cell = m_majorant[(static_cast<std::size_t>(z / span[2]) * m_cells[1] + y / span[1]) * m_cells[0] +
-                                 x / span[0]];
-        cell = std::max(cell, mu);
-      }
+  if (medium.interpolation == Interpolation::Trilinear) {
+    build_trilinear(medium, sigma_t_max, span);
+  } else {
+    for (int z = 0; z < d[2]; ++z)
+      for (int y = 0; y < d[1]; ++y)
+        for (int x = 0; x < d[0]; ++x) {
+          const std::size_t v = (static_cast<std::size_t>(z) * d[1] + y) * d[0] + x;
+          const std::uint16_t m = medium.material[v];
+          if (m == Medium::kEmpty) continue;
+          const float mu = medium.density[v] * sigma_t_max[m];
+          float& cell = m_majorant[(static_cast<std::size_t>(z / span[2]) * m_cells[1] + y / span[1]) * m_cells[0] +
+                                   x / span[0]];
+          cell = std::max(cell, mu);
+        }
+  }
   for (float mu : m_majorant) m_max = std::max(m_max, mu);
+}
+
+void MajorantGrid::build_trilinear(const Medium& medium, const std::vector<float>& sigma_t_max,
+                                   const std::array<int, 3>& span) {
+  // A point of cell c lies between voxel centres whose indices run from c·span − 1 to c·span + span
+  // (clamped to the volume), and its interpolated value lies between the least and the largest of
+  // those voxels' values (the tracer clamps it so, against float rounding). The classification of a
+  // value is not monotone (a bright voxel beside a dark one passes through every material between
+  // them), so the bound is the largest σt over that whole value range: for every rule whose range
+  // meets [v_lo, v_hi], its ramp's largest density there × the material's largest σt.
+  const auto& d = medium.dims;
+  for (int cz = 0; cz < m_cells[2]; ++cz)
+    for (int cy = 0; cy < m_cells[1]; ++cy)
+      for (int cx = 0; cx < m_cells[0]; ++cx) {
+        const int c[3] = {cx, cy, cz};
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::max(0, c[a] * span[a] - 1);
+          hi[a] = std::min(d[a] - 1, c[a] * span[a] + span[a]);
+        }
+        float v_lo = std::numeric_limits<float>::infinity(), v_hi = -v_lo;
+        for (int z = lo[2]; z <= hi[2]; ++z)
+          for (int y = lo[1]; y <= hi[1]; ++y) {
+            const float* row = medium.value.data() + (static_cast<std::size_t>(z) * d[1] + y) * d[0];
+            for (int x = lo[0]; x <= hi[0]; ++x) {
+              if (!std::isfinite(row[x])) continue;  // a point touching it is empty space
+              v_lo = std::min(v_lo, row[x]);
+              v_hi = std::max(v_hi, row[x]);
+            }
+          }
+        if (!(v_lo <= v_hi)) continue;
+        float mu = 0.0f;
+        for (const MaterialRule& r : medium.rules) {
+          const double a = std::max<double>(r.value_lo, v_lo), b = std::min<double>(r.value_hi, v_hi);
+          if (!(a <= b)) continue;
+          const auto dmax = static_cast<float>(r.density.max_over(a, b));
+          mu = std::max(mu, dmax * sigma_t_max[static_cast<std::size_t>(r.material)]);
+        }
+        // One float ulp of headroom: the tracer evaluates the ramp at the point in double, rounds.
+        if (mu > 0.0f) mu = std::nextafter(mu, std::numeric_limits<float>::infinity());
+        m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] = mu;
+      }
 }
 
 bool intersect_box(const Ray& ray, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double& t_enter,

@@ -41,6 +41,7 @@ std::string lights_to_json(const std::vector<Light>& lights) {
                    {"direction", {l.direction.x(), l.direction.y(), l.direction.z()}},
                    {"angularSizeDeg", l.angular_size_deg},
                    {"spectrum", l.spectrum_spec}});
+    if (l.emission) arr.back()["emission"] = true;  // only then: files without emission unchanged
   }
   return arr.dump();
 }
@@ -63,6 +64,7 @@ std::vector<Light> lights_from_image(const spectral::SpectralImage& image) {
         if (d.size() == 3) l.direction = Eigen::Vector3d(d[0], d[1], d[2]);
         l.angular_size_deg = j.value("angularSizeDeg", 0.0);
         l.spectrum_spec = j.value("spectrum", std::string("D65"));
+        l.emission = j.contains("emission") && j.at("emission").is_boolean() && j.at("emission").get<bool>();
       }
     }
     out.push_back(l);

@@ -37,6 +37,14 @@ PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi
   if (med.dims[0] < 1 || med.dims[1] < 1 || med.dims[2] < 1 || med.material.size() != med.voxel_count() ||
       med.density.size() != med.voxel_count())
     throw spectral::InputError("medium", "voxel arrays do not match dims");
+  m_trilinear = med.interpolation == Interpolation::Trilinear;
+  if (m_trilinear) {
+    if (med.value.size() != med.voxel_count())
+      throw spectral::InputError("medium", "trilinear interpolation needs one value per voxel");
+    for (const MaterialRule& r : med.rules)
+      if (r.material < 0 || static_cast<std::size_t>(r.material) >= med.materials.size())
+        throw spectral::InputError("medium", "rule names material " + std::to_string(r.material) + ", which does not exist");
+  }
   for (int a = 0; a < 3; ++a) {
     const double extent = med.bounds_max[a] - med.bounds_min[a];
     if (!(extent > 0)) throw spectral::InputError("medium", "bounds must have positive extent");
@@ -50,7 +58,11 @@ PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi
     const double smax = spectrum_max_over(mat.sigma_t_per_unit, lambda_lo_nm, lambda_hi_nm);
     sigma_t_max[m] = std::nextafter(static_cast<float>(std::max(0.0, smax)), 1e30f);
     m_g_constant.push_back(mat.anisotropy.is_constant() ? 1 : 0);
-    if (!mat.albedo.is_constant() || !mat.sigma_t_per_unit.is_constant() || !mat.anisotropy.is_constant())
+    const bool emits = mat.emission.max_value() > 0.0;
+    m_emits.push_back(emits ? 1 : 0);
+    m_any_emission = m_any_emission || emits;
+    if (!mat.albedo.is_constant() || !mat.sigma_t_per_unit.is_constant() || !mat.anisotropy.is_constant() ||
+        !mat.emission.is_constant())
       m_wavelength_independent = false;
   }
   for (std::size_t v = 0; v < med.voxel_count(); ++v)
@@ -60,6 +72,11 @@ PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi
   m_grid = MajorantGrid(med, sigma_t_max, use_grid ? MajorantGrid::kCellVoxels : 0);
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     const Light& light = scene.lights[l];
+    if (light.emission) {
+      if (m_emission_light >= 0) throw spectral::InputError("lights", "more than one emission light");
+      m_emission_light = static_cast<int>(l);
+      continue;
+    }
     if (light.direction.squaredNorm() == 0.0) continue;
     DirectionalLight d;
     d.direction = light.direction.normalized();
@@ -67,6 +84,8 @@ PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi
     m_lights.push_back(d);
     m_directional_index.push_back(static_cast<int>(l));
   }
+  if (m_any_emission && m_emission_light < 0)
+    throw spectral::InputError("lights", "a material emits but the scene has no emission light");
 }
 
 void PathTracer::prepare(PathScratch& s, int lanes) const {
@@ -77,9 +96,10 @@ void PathTracer::prepare(PathScratch& s, int lanes) const {
   s.sigma_t.assign(nm * n, 0.0f);
   s.albedo.assign(nm * n, 0.0f);
   s.g.assign(nm * n, 0.0f);
+  s.emission_le.assign(nm * n, 0.0f);
   s.material_stamp.assign(nm, 0);
   s.path_id = 0;
-  for (auto* v : {&s.weight, &s.transmittance, &s.phase, &s.sigma_a, &s.sigma_s, &s.sigma_n, &s.environment})
+  for (auto* v : {&s.weight, &s.transmittance, &s.phase, &s.sigma_a, &s.sigma_s, &s.sigma_n, &s.environment, &s.emission})
     v->assign(n, 0.0f);
   s.directional.assign(m_lights.size() * n, 0.0f);
 }
@@ -97,23 +117,82 @@ void PathTracer::evaluate_material(int m, PathScratch& s) const {
   float* st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
   float* al = s.albedo.data() + static_cast<std::size_t>(m) * n;
   float* g = s.g.data() + static_cast<std::size_t>(m) * n;
+  float* le = s.emission_le.data() + static_cast<std::size_t>(m) * n;
   for (int i = 0; i < n; ++i) {
     const double l = s.lambda_nm[i];
     st[i] = static_cast<float>(std::max(0.0, mat.sigma_t_per_unit.eval(l)));
     al[i] = static_cast<float>(std::clamp(mat.albedo.eval(l), 0.0, 1.0));
     g[i] = static_cast<float>(std::clamp(mat.anisotropy.eval(l), -0.9999, 0.9999));
+    if (m_emits[m]) le[i] = static_cast<float>(std::max(0.0, mat.emission.eval(l)));
   }
   s.material_stamp[m] = s.path_id;
 }
 
 void PathTracer::lookup(const Eigen::Vector3d& p, std::uint16_t& material, float& density) const {
   const Medium& med = *m_medium;
+  if (m_trilinear) {
+    classify(interpolate(p), material, density);
+    return;
+  }
   int idx[3];
   for (int a = 0; a < 3; ++a)
     idx[a] = std::clamp(static_cast<int>((p[a] - med.bounds_min[a]) * m_inv_voxel[a]), 0, med.dims[a] - 1);
   const std::size_t v = (static_cast<std::size_t>(idx[2]) * med.dims[1] + idx[1]) * med.dims[0] + idx[0];
   material = med.material[v];
   density = med.density[v];
+}
+
+float PathTracer::interpolate(const Eigen::Vector3d& p) const {
+  // Trilinear between voxel centres (voxel i's centre at continuous coordinate i + 0.5), clamped to
+  // the edge voxels within half a voxel of the box's faces. A point whose eight voxels include a
+  // non-finite value is empty (NaN). The result is clamped to the eight values' range so that the
+  // majorant grid's bound over that range holds exactly, float rounding included.
+  const Medium& med = *m_medium;
+  int i0[3], i1[3];
+  float f[3];
+  for (int a = 0; a < 3; ++a) {
+    const double x = (p[a] - med.bounds_min[a]) * m_inv_voxel[a] - 0.5;
+    const double fl = std::floor(x);
+    f[a] = static_cast<float>(x - fl);
+    const int i = static_cast<int>(fl);
+    i0[a] = std::clamp(i, 0, med.dims[a] - 1);
+    i1[a] = std::clamp(i + 1, 0, med.dims[a] - 1);
+  }
+  const std::size_t nx = static_cast<std::size_t>(med.dims[0]), nxy = nx * med.dims[1];
+  const float* v = med.value.data();
+  auto at = [&](int x, int y, int z) { return v[static_cast<std::size_t>(z) * nxy + static_cast<std::size_t>(y) * nx + x]; };
+  const float c000 = at(i0[0], i0[1], i0[2]), c100 = at(i1[0], i0[1], i0[2]);
+  const float c010 = at(i0[0], i1[1], i0[2]), c110 = at(i1[0], i1[1], i0[2]);
+  const float c001 = at(i0[0], i0[1], i1[2]), c101 = at(i1[0], i0[1], i1[2]);
+  const float c011 = at(i0[0], i1[1], i1[2]), c111 = at(i1[0], i1[1], i1[2]);
+  const float lo = std::min({c000, c100, c010, c110, c001, c101, c011, c111});
+  const float hi = std::max({c000, c100, c010, c110, c001, c101, c011, c111});
+  if (!std::isfinite(lo) || !std::isfinite(hi) ||
+      !std::isfinite(c000 + c100 + c010 + c110 + c001 + c101 + c011 + c111))
+    return std::numeric_limits<float>::quiet_NaN();
+  const float x00 = c000 + f[0] * (c100 - c000), x10 = c010 + f[0] * (c110 - c010);
+  const float x01 = c001 + f[0] * (c101 - c001), x11 = c011 + f[0] * (c111 - c011);
+  const float y0 = x00 + f[1] * (x10 - x00), y1 = x01 + f[1] * (x11 - x01);
+  return std::clamp(y0 + f[2] * (y1 - y0), lo, hi);
+}
+
+void PathTracer::classify(float value, std::uint16_t& material, float& density) const {
+  // Post-classification, exactly as build_medium classifies a voxel: the first rule whose range
+  // holds the value, its density ramp at the value; empty when none matches or the density is 0.
+  material = Medium::kEmpty;
+  density = 0.0f;
+  if (!std::isfinite(value)) return;
+  const double v = value;
+  for (const MaterialRule& r : m_medium->rules) {
+    if (v >= r.value_lo && v <= r.value_hi) {
+      const auto d = static_cast<float>(r.density.eval(v));
+      if (d > 0.0f) {
+        material = static_cast<std::uint16_t>(r.material);
+        density = d;
+      }
+      return;
+    }
+  }
 }
 
 void PathTracer::trace(const Ray& ray, Rng& rng, PathScratch& s) const {
@@ -183,9 +262,11 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   float* __restrict ss = s.sigma_s.data();
   float* __restrict sn = s.sigma_n.data();
   float* __restrict f = s.phase.data();
+  float* __restrict em = s.emission.data();
   for (int i = 0; i < n; ++i) {
     w[i] = 1.0f;
     env[i] = 0.0f;
+    em[i] = 0.0f;
   }
   std::fill(s.directional.begin(), s.directional.end(), 0.0f);
 
@@ -234,6 +315,14 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
           ma = std::max(ma, w[i] * sa[i]);
           ms = std::max(ms, w[i] * ss[i]);
           mn = std::max(mn, w[i] * sn[i]);
+        }
+        if (m_emits[m]) {
+          // Emission, pbrt-v4's estimator: at every tentative collision, before the event is chosen,
+          // w_i σa,i Le,i / μ̄ (collisions come at rate μ̄, so the sum estimates ∫ T σa Le ds; the
+          // absorption event then contributes nothing and the null and scattering events keep their
+          // weights, which stays unbiased whatever the event probabilities).
+          const float* __restrict le = s.emission_le.data() + static_cast<std::size_t>(m) * n;
+          for (int i = 0; i < n; ++i) em[i] += w[i] * sa[i] * le[i] * inv_mu;
         }
         const float c = ma + ms + mn;
         if (!(c > 0.0f)) return;
@@ -288,21 +377,39 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
       }
     }
 
-    // New direction from the phase function. With g varying across lanes: sample one lane's lobe
-    // chosen uniformly (one-sample MIS over lanes), weight each lane by p_i / mean_j p_j.
+    // New direction from the phase function. With g varying across lanes: one-sample MIS over the
+    // lanes' lobes with the balance heuristic (Veach 1997, §9.2.4), the lobe chosen in proportion to
+    // the lanes' current weights, c_j = w_j / W with W = Σ_j w_j. The direction's density is then
+    // q(ω) = Σ_j c_j p_j(ω) and lane i is weighted by p_i(ω) / q(ω):
+    //   w_i' = w_i p_i / q = W · w_i p_i / Σ_j w_j p_j.
+    // Unbiased: c is fixed before ω is drawn and q > 0 wherever any p_i > 0 (HG lobes with |g| < 1
+    // cover the sphere), so E[w_i p_i(ω)/q(ω)] = w_i ∫ p_i = w_i (the phase function's normalisation).
+    // Bounded: the denominator holds the term w_i p_i, so w_i' ≤ W; and Σ_i w_i' = W exactly, so the
+    // sum of the lane weights never changes at a scattering and no lane exceeds it (≤ n · max_j w_j,
+    // the per-lane factor w_i'/w_i ≤ 1/c_i). With uniform c (the previous estimator, factor p_i /
+    // mean_j p_j ≤ n per scattering) the factors multiply along the path without bound.
     float cos_theta;
     if (g_constant) {
       cos_theta = hg_sample_cos(g[0], rng.uniform());
     } else {
-      const int j = std::min(n - 1, static_cast<int>(rng.uniform() * static_cast<float>(n)));
+      float total = 0.0f;
+      for (int i = 0; i < n; ++i) total += w[i];
+      if (!(total > 0.0f)) return;
+      // Lane j with probability w_j / W (inverse CDF; lanes of weight 0 are never chosen).
+      const float target = rng.uniform() * total;
+      int j = 0;
+      float cdf = w[0];
+      while (j < n - 1 && cdf <= target) cdf += w[++j];
+      while (j > 0 && w[j] <= 0.0f) --j;  // float rounding past the end: the last lane that can be chosen
       cos_theta = hg_sample_cos(g[j], rng.uniform());
-      float sum = 0.0f;
+      float mix = 0.0f;  // Σ_j w_j p_j = W · q(ω)
       for (int i = 0; i < n; ++i) {
         f[i] = hg_phase(cos_theta, g[i]);
-        sum += f[i];
+        mix += w[i] * f[i];
       }
-      const float inv_pdf = static_cast<float>(n) / sum;
-      for (int i = 0; i < n; ++i) w[i] *= f[i] * inv_pdf;
+      if (!(mix > 0.0f)) return;
+      const float k = total / mix;
+      for (int i = 0; i < n; ++i) w[i] *= f[i] * k;
     }
     dir = direction_around(dir, cos_theta, rng.uniform_double()).normalized();
 

@@ -79,10 +79,12 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
     mode = LaneMode::Replicated;
   const int lanes = mode == LaneMode::AllBins ? nb : 1;
 
-  // Where each light's per-lane radiance comes from: the environment (−1) or a directional light.
+  // Where each light's per-lane radiance comes from: the environment (−1), the medium's emission
+  // (−2) or a directional light.
   std::vector<int> source(nl, -1);
   for (std::size_t k = 0; k < tracer.directional_lights().size(); ++k)
     source[tracer.directional_lights()[k]] = static_cast<int>(k);
+  if (tracer.emission_light() >= 0) source[tracer.emission_light()] = -2;
 
   // Test/benchmark mode: lights folded in with their default spectra.
   std::vector<spectral::Spectrum> fold;
@@ -146,8 +148,9 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
       // Lanes → (light, bin) values of this sample.
       bool finite = true;
       for (int l = 0; l < nl; ++l) {
-        const float* src = source[l] < 0 ? ps.environment.data()
-                                         : ps.directional.data() + static_cast<std::size_t>(source[l]) * lanes;
+        const float* src = source[l] == -2 ? ps.emission.data()
+                           : source[l] < 0 ? ps.environment.data()
+                                           : ps.directional.data() + static_cast<std::size_t>(source[l]) * lanes;
         double* out = v + static_cast<std::size_t>(l) * nb;
         switch (mode) {
           case LaneMode::AllBins:

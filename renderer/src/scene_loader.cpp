@@ -181,7 +181,7 @@ Volume read_volume(const Reader& rd, const json& j) {
     }
   }
   if (type == "procedural") {
-    rd.expect_object(j, path, {"type", "name", "resolution", "spacing"});
+    rd.expect_object(j, path, {"type", "name", "resolution", "spacing", "interpolation"});
     if (!j.contains("name")) rd.fail(Reader::join(path, "name"), "is required");
     const std::string name = rd.string(j.at("name"), Reader::join(path, "name"));
     const auto names = procedural_volume_names();
@@ -195,7 +195,7 @@ Volume read_volume(const Reader& rd, const json& j) {
                         : kDefaultResolution;
     vol = make_procedural_volume(name, res);
   } else if (type == "raw") {
-    rd.expect_object(j, path, {"type", "path", "dims", "voxel_type", "endianness", "spacing"});
+    rd.expect_object(j, path, {"type", "path", "dims", "voxel_type", "endianness", "spacing", "interpolation"});
     if (!j.contains("path")) rd.fail(Reader::join(path, "path"), "is required");
     RawVolumeSpec spec;
     spec.path = rd.file_path(j.at("path"), Reader::join(path, "path"));
@@ -224,7 +224,7 @@ Volume read_volume(const Reader& rd, const json& j) {
     spec.spacing = spacing;
     vol = load_raw_volume(spec);
   } else if (type == "nifti") {
-    rd.expect_object(j, path, {"type", "path", "spacing"});
+    rd.expect_object(j, path, {"type", "path", "spacing", "interpolation"});
     if (!j.contains("path")) rd.fail(Reader::join(path, "path"), "is required");
     vol = load_nifti_volume(rd.file_path(j.at("path"), Reader::join(path, "path")));
   } else {
@@ -232,6 +232,16 @@ Volume read_volume(const Reader& rd, const json& j) {
   }
   if (spacing_given) vol.spacing = spacing;
   return vol;
+}
+
+// volume.interpolation: "trilinear" (default) or "nearest".
+Interpolation read_interpolation(const Reader& rd, const json& j) {
+  if (!j.is_object() || !j.contains("interpolation")) return Interpolation::Trilinear;
+  const std::string ip = "volume.interpolation";
+  const std::string v = rd.string(j.at("interpolation"), ip);
+  if (v == "trilinear") return Interpolation::Trilinear;
+  if (v == "nearest") return Interpolation::Nearest;
+  rd.fail(ip, "must be \"trilinear\" or \"nearest\" (got \"" + v + "\")");
 }
 
 ValueNormalisation read_normalisation(const Reader& rd, const json& root, const Volume& vol) {
@@ -263,7 +273,7 @@ TransferFunction read_materials(const Reader& rd, const json& j, const ValueNorm
   for (std::size_t i = 0; i < j.size(); ++i) {
     const std::string mp = Reader::index(path, i);
     const json& mj = j[i];
-    rd.expect_object(mj, mp, {"name", "range", "units", "albedo", "extinction", "anisotropy", "density"});
+    rd.expect_object(mj, mp, {"name", "range", "units", "albedo", "extinction", "anisotropy", "density", "emission"});
     Material m;
     m.name = mj.contains("name") ? rd.string(mj.at("name"), Reader::join(mp, "name")) : "material" + std::to_string(i);
     if (m.name.empty()) rd.fail(Reader::join(mp, "name"), "must not be empty");
@@ -310,6 +320,14 @@ TransferFunction read_materials(const Reader& rd, const json& j, const ValueNorm
     m.anisotropy = mj.contains("anisotropy") ? rd.spectrum(mj.at("anisotropy"), Reader::join(mp, "anisotropy"))
                                              : Spectrum::constant(0.0);
     validate_material(m, rd.input(mp));
+    if (mj.contains("emission")) {
+      const std::string emp = Reader::join(mp, "emission");
+      m.emission = rd.spectrum(mj.at("emission"), emp);
+      if (!(m.emission.min_value() >= 0.0) || !std::isfinite(m.emission.max_value())) {
+        rd.fail(emp, "must be ≥ 0 and finite at every wavelength (got values in [" + num(m.emission.min_value()) +
+                         ", " + num(m.emission.max_value()) + "])");
+      }
+    }
 
     if (mj.contains("density")) {
       const std::string dp = Reader::join(mp, "density");
@@ -412,6 +430,18 @@ std::string absolute_spec(const std::string& spec, const std::filesystem::path& 
   const std::filesystem::path p(file);
   if (p.is_absolute() || base.empty()) return spec;
   return "csv:" + (base / p).string() + (star == std::string::npos ? "" : spec.substr(star));
+}
+
+// The emission layer's name: as a light's, 1–64 letters, digits, '_' and '-'.
+void check_light_name(const Reader& rd, const std::string& name, const std::string& path) {
+  if (name.empty() || name.size() > kMaxLightNameLength) {
+    rd.fail(path, "must have 1 to " + std::to_string(kMaxLightNameLength) + " characters (got \"" + name + "\")");
+  }
+  for (char ch : name) {
+    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-')) {
+      rd.fail(path, "may hold only letters, digits, '_' and '-' (got \"" + name + "\")");
+    }
+  }
 }
 
 std::vector<Light> read_lights(const Reader& rd, const json& j) {
@@ -554,7 +584,8 @@ Scene load_scene(const std::filesystem::path& path) {
   const Reader rd(file, path.parent_path());
   rd.expect_object(root, "",
                    {"description", "volume", "normalisation", "materials", "transfer_function", "camera", "lights",
-                    "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "target_error", "output"});
+                    "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "target_error", "output",
+                    "emission_light"});
   if (root.contains("description")) rd.string(root.at("description"), "description");
   if (!root.contains("volume")) rd.fail("volume", "is required");
   if (!root.contains("lights")) rd.fail("lights", "is required (at least one light)");
@@ -575,11 +606,32 @@ Scene load_scene(const std::filesystem::path& path) {
   scene.output = path.parent_path() / (path.stem().string() + ".exr");
   if (root.contains("output")) scene.output = rd.file_path(root.at("output"), "output");
 
+  const Interpolation interpolation = read_interpolation(rd, root.at("volume"));
   Volume vol = read_volume(rd, root.at("volume"));
   const ValueNormalisation norm = read_normalisation(rd, root, vol);
   const TransferFunction tf = has_materials ? read_materials(rd, root.at("materials"), norm)
                                             : read_tf_image(rd, root.at("transfer_function"), norm);
-  scene.medium = build_medium(vol, tf, rd.input("volume"));
+  scene.medium = build_medium(vol, tf, rd.input("volume"), interpolation);
+
+  // Emission: one light layer for every emitting material, only when some material emits (a scene
+  // without emission renders exactly as before).
+  std::string emission_name = "emission";
+  if (root.contains("emission_light")) {
+    emission_name = rd.string(root.at("emission_light"), "emission_light");
+    check_light_name(rd, emission_name, "emission_light");
+  }
+  const bool emits = std::any_of(scene.medium.materials.begin(), scene.medium.materials.end(),
+                                 [](const Material& m) { return m.emission.max_value() > 0.0; });
+  if (emits) {
+    for (const Light& l : scene.lights)
+      if (l.name == emission_name)
+        rd.fail("emission_light", "the emission layer \"" + emission_name + "\" has the name of a light (name it with emission_light)");
+    Light e;
+    e.name = emission_name;
+    e.emission = true;
+    e.spectrum_spec = "E";
+    scene.lights.push_back(std::move(e));
+  }
 
   // Hash: scene text, volume values, the materials' spectra (which csv files or images may supply).
   Fnv1a h;
@@ -592,6 +644,7 @@ Scene load_scene(const std::filesystem::path& path) {
     h.add_spectrum(m.albedo);
     h.add_spectrum(m.sigma_t_per_unit);
     h.add_spectrum(m.anisotropy);
+    if (m.emission.max_value() > 0.0) h.add_spectrum(m.emission);  // hashes of scenes without emission unchanged
   }
   scene.hash = h.hex();
   return scene;

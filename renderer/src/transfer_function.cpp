@@ -47,6 +47,13 @@ double DensityRamp::eval(double value) const {
   return densities[i - 1] + t * (densities[i] - densities[i - 1]);
 }
 
+double DensityRamp::max_over(double lo, double hi) const {
+  double m = std::max(eval(lo), eval(hi));
+  for (std::size_t k = 0; k < values.size(); ++k)
+    if (values[k] > lo && values[k] < hi) m = std::max(m, densities[k]);
+  return m;
+}
+
 double ValueNormalisation::to_unit(double v) const {
   const double t = (v - min) / (max - min);
   return std::clamp(t, 0.0, 1.0);
@@ -179,7 +186,8 @@ TransferFunction read_transfer_function_image(const std::filesystem::path& image
   return tf;
 }
 
-Medium build_medium(const Volume& vol, const TransferFunction& tf, const std::string& input) {
+Medium build_medium(const Volume& vol, const TransferFunction& tf, const std::string& input,
+                    Interpolation interpolation) {
   if (tf.materials.size() > 65534) {
     throw InputError(input, "at most 65534 materials are supported (got " + std::to_string(tf.materials.size()) + ")");
   }
@@ -197,6 +205,11 @@ Medium build_medium(const Volume& vol, const TransferFunction& tf, const std::st
   Medium m;
   m.dims = vol.dims;
   m.materials = tf.materials;
+  m.interpolation = interpolation;
+  if (interpolation == Interpolation::Trilinear) {
+    m.value = vol.values;
+    m.rules = tf.rules;
+  }
 
   // World box: dims × spacing, largest side 1, centred at the origin.
   double extent[3];

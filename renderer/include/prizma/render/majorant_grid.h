@@ -1,7 +1,8 @@
 #pragma once
 // MajorantGrid: macrocells of kCellVoxels³ voxels over the medium, each holding an upper bound of the
 // extinction σt(λ) inside it over every wavelength of the render (density × the material's largest
-// σt in the bins' range). Free-flight and transmittance sampling walk the cells with a 3-D DDA
+// σt in the bins' range; with trilinear interpolation, the largest σt that any value between the
+// cell's and its neighbours' voxel values classifies to). Free-flight and transmittance sampling walk the cells with a 3-D DDA
 // (Amanatides & Woo 1987), so cells whose majorant is 0 cost one step. With one cell it is the single
 // global majorant (settings.use_majorant_grid = false).
 #include <Eigen/Core>
@@ -32,6 +33,8 @@ class MajorantGrid {
   const Eigen::Vector3d& cell_size() const { return m_cell_size; }
 
  private:
+  void build_trilinear(const Medium& medium, const std::vector<float>& sigma_t_max, const std::array<int, 3>& span);
+
   std::array<int, 3> m_cells{1, 1, 1};
   Eigen::Vector3d m_min{0, 0, 0}, m_max_corner{0, 0, 0}, m_cell_size{1, 1, 1};
   std::vector<float> m_majorant;

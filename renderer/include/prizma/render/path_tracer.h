@@ -3,7 +3,8 @@
 // "lanes", each a wavelength with its own weight: all bins (spectral tracking, Kutz et al. 2017,
 // max scheme), or one lane (a wavelength-independent medium traced once for all bins, or VPT's
 // one-wavelength method). It returns, per lane, the radiance reaching the camera from the uniform
-// unit environment and from each directional light of unit irradiance (unit white spectra).
+// unit environment, from each directional light of unit irradiance (unit white spectra), and the
+// radiance the medium emits (the emission light).
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
@@ -30,6 +31,7 @@ struct PathScratch {
   std::vector<float> sigma_t;       // [material][lanes] per unit density, at the path's wavelengths
   std::vector<float> albedo;        // [material][lanes]
   std::vector<float> g;             // [material][lanes]
+  std::vector<float> emission_le;   // [material][lanes] emitted radiance at density 1 (emitting materials)
   std::vector<std::uint32_t> material_stamp;  // path id that last evaluated each material
   std::uint32_t path_id = 0;
   std::vector<float> weight;        // [lanes] path throughput
@@ -38,6 +40,7 @@ struct PathScratch {
   std::vector<float> sigma_a, sigma_s, sigma_n;  // [lanes] at the current collision
   std::vector<float> environment;   // [lanes] result: radiance from the unit environment
   std::vector<float> directional;   // [directional light][lanes] result
+  std::vector<float> emission;      // [lanes] result: radiance emitted by the medium (the emission light)
   PathCounters counters;
 };
 
@@ -58,6 +61,11 @@ class PathTracer {
   // Directional (non-environment) lights, in scene order: their indices in scene.lights.
   const std::vector<int>& directional_lights() const { return m_directional_index; }
   const MajorantGrid& grid() const { return m_grid; }
+  // Index in scene.lights of the emission light (Light::emission), or −1.
+  int emission_light() const { return m_emission_light; }
+  // The medium at a point inside the box: material index (kEmpty for empty space) and density, by
+  // the medium's interpolation (nearest voxel, or the trilinear value classified by the rules).
+  void lookup(const Eigen::Vector3d& p, std::uint16_t& material, float& density) const;
   // True when every material's spectra are constant: one lane serves all bins.
   bool wavelength_independent() const { return m_wavelength_independent; }
 
@@ -71,8 +79,9 @@ class PathTracer {
   template <int kLanes>
   void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s) const;
   void evaluate_material(int m, PathScratch& s) const;
-  // Voxel at a point inside the box: material index (kEmpty outside) and density.
-  void lookup(const Eigen::Vector3d& p, std::uint16_t& material, float& density) const;
+  // Trilinear: the raw value at p (NaN when a contributing voxel is not finite), and its class.
+  float interpolate(const Eigen::Vector3d& p) const;
+  void classify(float value, std::uint16_t& material, float& density) const;
 
   const Medium* m_medium;
   MajorantGrid m_grid;
@@ -80,6 +89,10 @@ class PathTracer {
   std::vector<DirectionalLight> m_lights;
   std::vector<int> m_directional_index;
   std::vector<char> m_g_constant;  // per material
+  std::vector<char> m_emits;       // per material: emission > 0 somewhere
+  bool m_any_emission = false;
+  int m_emission_light = -1;
+  bool m_trilinear = false;
   int m_max_bounces = -1;
   bool m_wavelength_independent = false;
 };

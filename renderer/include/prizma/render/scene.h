@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "prizma/render/material_rule.h"
 #include "prizma/spectral/bin_layout.h"
 #include "prizma/spectral/spectrum.h"
 
@@ -20,10 +21,19 @@ struct Material {
   spectral::Spectrum albedo;           // single-scattering albedo, in [0, 1]
   spectral::Spectrum sigma_t_per_unit;  // extinction per scene unit at density 1, ≥ 0
   spectral::Spectrum anisotropy;       // Henyey–Greenstein g, in (−1, 1)
+  // Emitted radiance Le at density 1, ≥ 0 (source term σa·density·Le, as in pbrt-v4); it reaches the
+  // image through the scene's emission light layer (Light::emission).
+  spectral::Spectrum emission = spectral::Spectrum::constant(0.0);
 };
 
+// How the tracer reads the volume at a point: the nearest voxel's classification (blocks), or the
+// raw value interpolated trilinearly between voxel centres and then classified.
+enum class Interpolation { Nearest, Trilinear };
+
 // The medium the tracer sees: a box in world space split into voxels, each holding a material
-// index (or kEmpty) and a density multiplier. Nearest-voxel lookup: a voxel is a homogeneous cell.
+// index (or kEmpty) and a density multiplier (the classification at the voxel centre). With
+// Nearest a voxel is a homogeneous cell; with Trilinear the tracer interpolates `value` (raw values
+// at voxel centres, clamped to the edge voxels) and classifies the result with `rules`.
 struct Medium {
   static constexpr std::uint16_t kEmpty = 0xFFFF;
   std::array<int, 3> dims{0, 0, 0};
@@ -32,6 +42,9 @@ struct Medium {
   std::vector<std::uint16_t> material;  // per voxel, x fastest
   std::vector<float> density;           // per voxel, ≥ 0
   std::vector<Material> materials;
+  Interpolation interpolation = Interpolation::Nearest;
+  std::vector<float> value;          // Trilinear: raw value per voxel, x fastest (non-finite = empty)
+  std::vector<MaterialRule> rules;   // Trilinear: value → material and density, first match wins
 
   std::size_t voxel_count() const { return static_cast<std::size_t>(dims[0]) * dims[1] * dims[2]; }
 };
@@ -41,6 +54,9 @@ struct Light {
   Eigen::Vector3d direction{0, 0, 0};  // toward the light; the zero vector = uniform environment
   double angular_size_deg = 0.0;   // directional lights only: full apex angle of the cone, 0 = delta
   std::string spectrum_spec = "D65";  // default spectrum, used only for previews
+  // The emission layer: the radiance emitted by the medium's materials (Material::emission) at unit
+  // white; direction and angular size unused. At most one per scene.
+  bool emission = false;
 };
 
 enum class CameraType { Perspective, Orthographic };

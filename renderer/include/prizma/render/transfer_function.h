@@ -8,26 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "prizma/render/material_rule.h"
 #include "prizma/render/scene.h"
 #include "prizma/render/volume.h"
 
 namespace prizma::render {
-
-// Piecewise-linear density multiplier over the raw value; constant beyond the end points.
-// No points = density 1 everywhere.
-struct DensityRamp {
-  std::vector<double> values;     // strictly increasing
-  std::vector<double> densities;  // ≥ 0, finite, same size as values
-  double eval(double value) const;
-};
-
-// Voxels whose raw value v satisfies value_lo ≤ v ≤ value_hi get `material` (first matching rule).
-struct MaterialRule {
-  double value_lo = -std::numeric_limits<double>::infinity();
-  double value_hi = std::numeric_limits<double>::infinity();
-  int material = 0;  // index into TransferFunction::materials
-  DensityRamp density;
-};
 
 struct TransferFunction {
   std::vector<Material> materials;
@@ -62,8 +47,11 @@ TransferFunction read_transfer_function_image(const std::filesystem::path& image
 
 // Applies the rules to every voxel (material index, or Medium::kEmpty when no rule matches or the
 // value is not finite; density = the rule's ramp at the value) and sets the world box: extents
-// dims × spacing scaled so the largest side is 1, centred at the origin. Throws InputError (input
-// `input`) with more than 65534 materials or a rule naming a missing material.
-Medium build_medium(const Volume& vol, const TransferFunction& tf, const std::string& input);
+// dims × spacing scaled so the largest side is 1, centred at the origin. With Trilinear the medium
+// also keeps the raw values and the rules, and the tracer classifies the value interpolated at each
+// point (post-classification). Throws InputError (input `input`) with more than 65534 materials or
+// a rule naming a missing material.
+Medium build_medium(const Volume& vol, const TransferFunction& tf, const std::string& input,
+                    Interpolation interpolation = Interpolation::Nearest);
 
 }  // namespace prizma::render
