@@ -14,6 +14,7 @@
 #include "prizma/relight/interactive_shell.h"
 #include "prizma/relight/output_image.h"
 #include "prizma/relight/relight_session.h"
+#include "prizma/relight/serve.h"
 #include "prizma/relight/terminal_preview.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/colour_matching.h"
@@ -43,6 +44,10 @@ struct CliOptions {
   std::string preview;
   bool show = false;
   bool verbose = false;
+  bool serve = false;
+  std::string bind = "127.0.0.1";
+  int port = 0;
+  std::string save_dir = ".";
 };
 
 const char* cmf_table(spectral::Observer obs) {
@@ -83,9 +88,10 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
 }
 
 int run(const CliOptions& o) {
-  if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show) {
-    throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i or --show");
+  if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show && !o.serve) {
+    throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i, --show or --serve");
   }
+  if (o.serve && o.interactive) throw InputError("--serve", "not with -i/--interactive");
   if (!o.preview.empty() && !o.interactive) throw InputError("--preview", "only with -i/--interactive");
   // Cheap checks first: nothing is loaded when the output cannot be written.
   if (!o.output.empty()) relight::check_output_path(o.output, "--output");
@@ -125,6 +131,19 @@ int run(const CliOptions& o) {
     const relight::XyzImage& img = session.xyz();
     relight::print_terminal_thumbnail(std::cout, relight::to_display(img, session.display()), img.width, img.height);
   }
+  if (o.serve) {
+    relight::ServeOptions so;
+    so.bind = o.bind;
+    so.port = o.port;
+    so.save_dir = o.save_dir;
+    relight::RelightServer server(session, so);
+    if (!relight::is_loopback_address(o.bind)) {
+      std::cerr << "prizma-relight: warning: --bind " << o.bind
+                << " is not a loopback address: every host that can reach it sees the page and can save files\n";
+    }
+    relight::serve_until_signal(server, [&] { std::cout << server.url() << std::endl; });
+    if (o.verbose) std::cerr << "prizma-relight: server stopped\n";
+  }
   if (o.interactive) {
     relight::InteractiveOptions io;
     io.preview = o.preview;
@@ -158,6 +177,10 @@ int main(int argc, char** argv) {
   app.add_option("--preview", o.preview, "interactive: image rewritten after every change");
   app.add_flag("--show", o.show, "print a true-colour terminal thumbnail");
   app.add_flag("--verbose", o.verbose, "echo data files, OCIO config and lights");
+  app.add_flag("--serve", o.serve, "serve the live relighting page (prints its URL; Ctrl-C stops it)");
+  app.add_option("--bind", o.bind, "--serve: address to listen on")->capture_default_str();
+  app.add_option("--port", o.port, "--serve: port (0: a free one)")->check(CLI::Range(0, 65535))->capture_default_str();
+  app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")->capture_default_str();
   app.set_version_flag("--version", prizma::spectral::prizma_version());
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
   return spectral::run_tool("prizma-relight", [&] { return run(o); });
