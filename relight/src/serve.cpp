@@ -286,8 +286,8 @@ void RelightServer::Impl::routes() {
     const int y = int_param(req, "y", 0, session.image().height - 1);
     apply_state(req, {"x", "y"});
     const ProbeResult p = session.probe(x, y);
-    json bins = json::object();
-    for (std::size_t l = 0; l < p.bins.size(); ++l) bins[session.light_names()[l]] = p.bins[l];
+    json bins = json::array();  // in the file's light order
+    for (std::size_t l = 0; l < p.bins.size(); ++l) bins.push_back({{"name", session.light_names()[l]}, {"bins", p.bins[l]}});
     send_json(res, {{"x", x}, {"y", y}, {"bins", bins}, {"xyz", vec3(p.xyz)}, {"lab", vec3(p.lab)},
                     {"srgb", vec3(p.srgb)}});
   }));

@@ -297,6 +297,11 @@ function setupGL() {
   if (!gl) throw new Error('this browser has no WebGL2');
   canvas.width = info.width;
   canvas.height = info.height;
+  // Shown at an integer zoom (pixels stay square) that fits the view, or scaled down to fit it.
+  const room = Math.max(200, $('view').clientWidth);
+  const zoom = info.width <= room ? Math.min(8, Math.floor(room / info.width)) : room / info.width;
+  canvas.style.width = Math.round(info.width * zoom) + 'px';
+  canvas.style.height = Math.round(info.height * zoom) + 'px';
   const layers = info.lights.length * info.groups;
   const need = 3 * layers + 8;
   if (need > gl.getParameter(gl.MAX_FRAGMENT_UNIFORM_VECTORS)) {
@@ -482,8 +487,8 @@ async function probe(x, y) {
     $('probe').textContent = 'pixel (' + x + ', ' + y + ')   sRGB ' + f3(r.srgb) + '   Lab ' + f3(r.lab, 2) +
                              '   XYZ ' + f3(r.xyz);
     const c = $('probeplot');
-    plotSteps(c.getContext('2d'), Object.keys(r.bins).map((name, k) => ({ values: r.bins[name],
-      colour: kPalette[k % kPalette.length], label: 'T ' + name })), c.width, c.height, true);
+    plotSteps(c.getContext('2d'), r.bins.map((l, k) => ({ values: l.bins, colour: kPalette[k % kPalette.length],
+                                                          label: 'T ' + l.name })), c.width, c.height, true);
   } catch (e) { $('probe').textContent = e.message; } finally { probeBusy = false; }
 }
 
@@ -501,6 +506,14 @@ canvas.addEventListener('click', (ev) => {
   if (!info) return;
   if (picks.length === 2) picks.length = 0;
   picks.push(pixelOf(ev));
+  ['markA', 'markB'].forEach((id, k) => {
+    const m = $(id);
+    m.classList.toggle('hidden', k >= picks.length);
+    if (k < picks.length) {
+      m.style.left = ((picks[k].x + 0.5) / info.width * canvas.clientWidth) + 'px';
+      m.style.top = ((picks[k].y + 0.5) / info.height * canvas.clientHeight) + 'px';
+    }
+  });
   if (picks.length === 2) compare();
   else $('compare').textContent = 'A (' + picks[0].x + ', ' + picks[0].y + '): click a second pixel';
 });

@@ -117,10 +117,15 @@ def test_server(relight, workdir):
         "binary bytes": bytes(range(256)) * 4 + b"\r\n\r\n",
         "a foreign Host (DNS rebinding)": b"GET /api/info HTTP/1.1\r\nHost: evil.example:%d\r\n\r\n" % p,
         "an unknown method": b"BREW / HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n\r\n" % p,
-        "a huge body": b"POST /api/save HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nContent-Length: 99999999\r\n\r\nabc" % p,
+        "a huge body": b"POST /api/save HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nContent-Length: 99999999\r\n\r\n" % p,
     }
     for what, data in bad.items():
-        status = raw(p, data)
+        # The server answers an over-long request before reading all of it and closes; the unread
+        # bytes can turn its close into a reset that swallows the answer. Three tries.
+        for _ in range(3):
+            status = raw(p, data)
+            if status:
+                break
         check(400 <= status < 500 and alive(), "%s: %d, server up" % (what, status))
     api = {
         "save outside the folder": ("POST", "/api/save?file=../escape.png"),
