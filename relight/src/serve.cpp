@@ -88,9 +88,10 @@ struct RelightServer::Impl {
   // The request's state keys (light.*, exposure, cmf, display, adapt): every parameter not in `own`.
   RelightSettings settings_of(const httplib::Request& req, std::initializer_list<const char*> own) const {
     StateParams params;
-    for (const auto& [key, value] : req.params) {
-      if (std::find_if(own.begin(), own.end(), [&](const char* k) { return key == k; }) == own.end()) {
-        params.emplace_back(key, value);
+    for (const auto& param : req.params) {
+      const std::string& key = param.first;
+      if (std::find_if(own.begin(), own.end(), [&key](const char* k) { return key == k; }) == own.end()) {
+        params.emplace_back(key, param.second);
       }
     }
     return settings_from_state(params, session, base);
@@ -208,7 +209,7 @@ struct RelightServer::Impl {
   // Runs a handler, mapping InputError to 400 and any other failure to 500, with a JSON message.
   template <class F>
   httplib::Server::Handler guarded(F f) {
-    return [this, f](const httplib::Request& req, httplib::Response& res) {
+    return [f](const httplib::Request& req, httplib::Response& res) {
       try {
         f(req, res);
       } catch (const InputError& e) {

@@ -202,6 +202,18 @@ void main() {
 
 function fragmentSource(ocio) {
   const L = info.lights.length, G = info.groups;
+  // Σ_l M_l·T_l written out with constant indices (software GPUs index uniform arrays slowly).
+  let sum = '';
+  for (let l = 0; l < L; ++l) {
+    sum += '  if (u_on[' + l + ']) {\n';
+    for (let g = 0; g < G; ++g) {
+      const k = l * G + g;
+      sum += '    t = texelFetch(u_transport, ivec3(p, ' + k + '), 0);\n' +
+             '    xyz += vec3(dot(u_w[' + 3 * k + '], t), dot(u_w[' + (3 * k + 1) + '], t), dot(u_w[' + (3 * k + 2) +
+             '], t));\n';
+    }
+    sum += '  }\n';
+  }
   return `#version 300 es
 precision highp float;
 precision highp int;
@@ -223,14 +235,8 @@ ${ocio.glsl}
 void main() {
   ivec2 p = ivec2(int(gl_FragCoord.x), u_height - 1 - int(gl_FragCoord.y));
   vec3 xyz = vec3(0.0);
-  for (int l = 0; l < LIGHTS; ++l) {
-    if (!u_on[l]) continue;
-    for (int g = 0; g < GROUPS; ++g) {
-      int k = l * GROUPS + g;
-      vec4 t = texelFetch(u_transport, ivec3(p, k), 0);
-      xyz += vec3(dot(u_w[3 * k], t), dot(u_w[3 * k + 1], t), dot(u_w[3 * k + 2], t));
-    }
-  }
+  vec4 t;
+${sum}
   // As the CPU path: non-finite values become 0, the display output is clamped to [0, 1].
   for (int c = 0; c < 3; ++c) if (isnan(xyz[c]) || isinf(xyz[c])) xyz[c] = 0.0;
   vec4 rgb = ${ocio.function}(vec4(xyz, 1.0));
