@@ -63,6 +63,7 @@ bool contains(const std::vector<std::string>& names, const std::string& name) {
 struct DisplayTransform::Impl {
   fs::path config_path;
   OCIO::ConstConfigRcPtr config;
+  OCIO::ConstProcessorRcPtr processor;
   OCIO::ConstCPUProcessorRcPtr cpu;
   std::string description;
 };
@@ -131,6 +132,7 @@ DisplayTransform::DisplayTransform(const DisplayOptions& opts) : m_impl(std::mak
       processor = impl.config->getProcessor(t);
       impl.description = "CIE XYZ (D65) -> display \"" + opts.display + "\", view \"" + view + "\"";
     }
+    impl.processor = processor;
     // Lossless optimisation only: no fast pow/exp approximations.
     impl.cpu = processor->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32,
                                                    OCIO::OPTIMIZATION_LOSSLESS);
@@ -166,5 +168,87 @@ std::string DisplayTransform::description() const { return m_impl->description; 
 std::vector<std::string> DisplayTransform::displays() const { return list_displays(m_impl->config); }
 
 std::vector<std::string> DisplayTransform::colour_spaces() const { return list_colour_spaces(m_impl->config); }
+
+DisplayShader DisplayTransform::gpu_shader(const std::string& function_name) const {
+  DisplayShader out;
+  out.function_name = function_name;
+  try {
+    const auto gpu = m_impl->processor->getOptimizedGPUProcessor(OCIO::OPTIMIZATION_LOSSLESS);
+    OCIO::GpuShaderDescRcPtr desc = OCIO::GpuShaderDesc::CreateShaderDesc();
+    desc->setLanguage(OCIO::GPU_LANGUAGE_GLSL_ES_3_0);
+    desc->setFunctionName(function_name.c_str());
+    desc->setResourcePrefix("ocio_");
+    gpu->extractGpuShaderInfo(desc);
+    out.glsl = desc->getShaderText();
+    for (unsigned i = 0; i < desc->getNumUniforms(); ++i) {
+      OCIO::GpuShaderDesc::UniformData data;
+      DisplayShader::Uniform u;
+      u.name = desc->getUniform(i, data);
+      switch (data.m_type) {
+        case OCIO::UNIFORM_DOUBLE: u.type = "double"; u.values = {data.m_getDouble()}; break;
+        case OCIO::UNIFORM_BOOL: u.type = "bool"; u.values = {data.m_getBool() ? 1.0 : 0.0}; break;
+        case OCIO::UNIFORM_FLOAT3: {
+          u.type = "float3";
+          const auto v = data.m_getFloat3();
+          u.values = {v[0], v[1], v[2]};
+          break;
+        }
+        case OCIO::UNIFORM_VECTOR_FLOAT: {
+          u.type = "vector_float";
+          const float* v = data.m_vectorFloat.m_getVector();
+          u.values.assign(v, v + data.m_vectorFloat.m_getSize());
+          break;
+        }
+        case OCIO::UNIFORM_VECTOR_INT: {
+          u.type = "vector_int";
+          const int* v = data.m_vectorInt.m_getVector();
+          u.values.assign(v, v + data.m_vectorInt.m_getSize());
+          break;
+        }
+        case OCIO::UNIFORM_UNKNOWN: throw RuntimeError("OCIO GPU shader: uniform " + u.name + " has an unknown type");
+      }
+      out.uniforms.push_back(std::move(u));
+    }
+    for (unsigned i = 0; i < desc->getNumTextures(); ++i) {
+      const char* name = nullptr;
+      const char* sampler = nullptr;
+      unsigned width = 0, height = 0;
+      OCIO::GpuShaderDesc::TextureType channel{};
+      OCIO::Interpolation interpolation{};
+      desc->getTexture(i, name, sampler, width, height, channel, interpolation);
+      DisplayShader::Texture t;
+      t.name = name;
+      t.sampler = sampler;
+      t.width = static_cast<int>(width);
+      t.height = static_cast<int>(std::max(height, 1u));
+      t.channels = channel == OCIO::GpuShaderDesc::TEXTURE_RED_CHANNEL ? 1 : 3;
+      t.linear = interpolation != OCIO::INTERP_NEAREST;
+      const float* values = nullptr;
+      desc->getTextureValues(i, values);
+      t.values.assign(values, values + static_cast<std::size_t>(t.width) * t.height * t.channels);
+      out.textures.push_back(std::move(t));
+    }
+    for (unsigned i = 0; i < desc->getNum3DTextures(); ++i) {
+      const char* name = nullptr;
+      const char* sampler = nullptr;
+      unsigned edge = 0;
+      OCIO::Interpolation interpolation{};
+      desc->get3DTexture(i, name, sampler, edge, interpolation);
+      DisplayShader::Texture t;
+      t.name = name;
+      t.sampler = sampler;
+      t.width = t.height = t.depth = static_cast<int>(edge);
+      t.channels = 3;
+      t.linear = interpolation != OCIO::INTERP_NEAREST;
+      const float* values = nullptr;
+      desc->get3DTextureValues(i, values);
+      t.values.assign(values, values + static_cast<std::size_t>(edge) * edge * edge * 3);
+      out.textures.push_back(std::move(t));
+    }
+  } catch (const OCIO::Exception& e) {
+    throw RuntimeError(std::string("OCIO GPU shader: ") + e.what());
+  }
+  return out;
+}
 
 }  // namespace prizma::spectral

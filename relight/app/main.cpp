@@ -16,6 +16,7 @@
 #include "prizma/relight/output_image.h"
 #include "prizma/relight/relight_session.h"
 #include "prizma/relight/terminal_image.h"
+#include "prizma/relight/serve.h"
 #include "prizma/relight/terminal_preview.h"
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/cli_support.h"
@@ -47,6 +48,10 @@ struct CliOptions {
   bool show = false;
   bool show_every = false;
   bool verbose = false;
+  bool serve = false;
+  std::string bind = "127.0.0.1";
+  int port = 0;
+  std::string save_dir = ".";
 };
 
 const char* cmf_table(spectral::Observer obs) {
@@ -97,10 +102,11 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
 }
 
 int run(const CliOptions& o) {
-  if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show) {
-    throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i or --show");
+  if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show && !o.serve) {
+    throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i, --show or --serve");
   }
   if (o.show_every && !o.interactive) throw InputError("--show-every", "only with -i/--interactive");
+  if (o.serve && o.interactive) throw InputError("--serve", "not with -i/--interactive");
   if (!o.preview.empty() && !o.interactive) throw InputError("--preview", "only with -i/--interactive");
   // Cheap checks first: nothing is loaded when the output cannot be written.
   if (!o.output.empty()) relight::check_output_path(o.output, "--output");
@@ -159,6 +165,19 @@ int run(const CliOptions& o) {
       relight::print_terminal_thumbnail(std::cout, rgb, img.width, img.height);
     }
   }
+  if (o.serve) {
+    relight::ServeOptions so;
+    so.bind = o.bind;
+    so.port = o.port;
+    so.save_dir = o.save_dir;
+    relight::RelightServer server(session, so);
+    if (!relight::is_loopback_address(o.bind)) {
+      std::cerr << "prizma-relight: warning: --bind " << o.bind
+                << " is not a loopback address: every host that can reach it sees the page and can save files\n";
+    }
+    relight::serve_until_signal(server, [&] { std::cout << server.url() << std::endl; });
+    if (o.verbose) std::cerr << "prizma-relight: server stopped\n";
+  }
   if (o.interactive) {
     relight::InteractiveOptions io;
     io.preview = o.preview;
@@ -195,6 +214,10 @@ int main(int argc, char** argv) {
   app.add_flag("--show", o.show, "print a true-colour terminal thumbnail (with -i: draw the image at the start)");
   app.add_flag("--show-every", o.show_every, "interactive: draw the image after every change");
   app.add_flag("--verbose", o.verbose, "echo data files, OCIO config and lights");
+  app.add_flag("--serve", o.serve, "serve the live relighting page (prints its URL; Ctrl-C stops it)");
+  app.add_option("--bind", o.bind, "--serve: address to listen on")->capture_default_str();
+  app.add_option("--port", o.port, "--serve: port (0: a free one)")->check(CLI::Range(0, 65535))->capture_default_str();
+  app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")->capture_default_str();
   app.set_version_flag("--version", prizma::spectral::prizma_version());
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
   return spectral::run_tool("prizma-relight", [&] { return run(o); });

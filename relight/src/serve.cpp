@@ -1,0 +1,414 @@
+// prizma-relight --serve: routes of the live page over cpp-httplib. Every route is a fixed path; the
+// page and its script come from the binary (serve_assets.h), data from the loaded session.
+#include "prizma/relight/serve.h"
+
+#include <Imath/half.h>
+#include <arpa/inet.h>
+#include <httplib.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+#include <initializer_list>
+#include <map>
+#include <mutex>
+#include <regex>
+#include <system_error>
+#include <thread>
+
+#include "prizma/relight/serve_state.h"
+#include "prizma/spectral/colour.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/spectrum_spec.h"
+#include "prizma/spectral/tool_main.h"
+#include "serve_assets.h"
+
+namespace prizma::relight {
+
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using spectral::InputError;
+
+// Transport texels pack four bins each (RGBA); bins past the last are zero.
+constexpr int kBinsPerTexel = 4;
+// A saved file's name: a plain name, no folder, no leading dot.
+const std::regex kSaveName("[A-Za-z0-9][A-Za-z0-9._-]{0,127}");
+
+int texel_groups(int bins) { return (bins + kBinsPerTexel - 1) / kBinsPerTexel; }
+
+void send_json(httplib::Response& res, const json& body, int status = 200) {
+  res.status = status;
+  res.set_content(body.dump(), "application/json");
+}
+
+// An integer request parameter within [lo, hi]; InputError naming it otherwise.
+int int_param(const httplib::Request& req, const std::string& key, int lo, int hi) {
+  if (!req.has_param(key)) throw InputError(key, "missing");
+  const std::string v = req.get_param_value(key);
+  int out = 0;
+  const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+  if (v.empty() || ec != std::errc() || ptr != v.data() + v.size() || out < lo || out > hi) {
+    throw InputError(key, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], not \"" +
+                              v + "\"");
+  }
+  return out;
+}
+
+json vec3(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace
+
+bool is_loopback_address(const std::string& address) {
+  if (address == "localhost" || address == "::1") return true;
+  in_addr v4{};
+  if (::inet_pton(AF_INET, address.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
+  return false;
+}
+
+struct RelightServer::Impl {
+  RelightSession& session;
+  ServeOptions opts;
+  RelightSettings base;  // the command line's settings: the page's starting state
+  httplib::Server server;
+  int port = 0;
+  std::mutex mutex;  // guards session and caches (httplib runs handlers on a thread pool)
+  std::map<std::string, std::string> display_cache;
+
+  Impl(RelightSession& s, const ServeOptions& o) : session(s), opts(o), base(s.settings()) {}
+
+  // The request's state keys (light.*, exposure, cmf, display, adapt): every parameter not in `own`.
+  RelightSettings settings_of(const httplib::Request& req, std::initializer_list<const char*> own) const {
+    StateParams params;
+    for (const auto& param : req.params) {
+      const std::string& key = param.first;
+      if (std::find_if(own.begin(), own.end(), [&key](const char* k) { return key == k; }) == own.end()) {
+        params.emplace_back(key, param.second);
+      }
+    }
+    return settings_from_state(params, session, base);
+  }
+
+  // Applies the request's state to the session and checks that its lights and display are usable.
+  void apply_state(const httplib::Request& req, std::initializer_list<const char*> own) {
+    RelightSettings s = settings_of(req, own);
+    for (std::size_t l = 0; l < s.lights.size(); ++l) {
+      // A recorded default that did not parse here (a CSV from another machine) cannot be drawn.
+      const LightSpec& d = session.default_lights()[l];
+      if (s.lights[l].off && d.off && s.lights[l].text == d.text && d.text != "off") {
+        parse_light_spec(d.text, {"light." + session.light_names()[l], {}});
+      }
+    }
+    session.apply(std::move(s));
+    session.display();  // throws InputError for an unknown display
+  }
+
+  json info() const {
+    const auto& img = session.image();
+    json lights = json::array();
+    for (std::size_t l = 0; l < session.light_names().size(); ++l) {
+      lights.push_back({{"name", session.light_names()[l]},
+                        {"default", session.default_lights()[l].text},
+                        {"spec", base.lights[l].text}});
+    }
+    spectral::DisplayOptions d = base.output.display;
+    d.colour_space.clear();
+    return {{"source", fs::path(session.source()).filename().string()},
+            {"version", spectral::prizma_version()},
+            {"width", img.width},
+            {"height", img.height},
+            {"bins", img.bins.edges_nm()},
+            {"binsPerTexel", kBinsPerTexel},
+            {"groups", texel_groups(img.bins.size())},
+            {"lights", lights},
+            {"state", state_string(base, session)},
+            {"displays", spectral::DisplayTransform(d).displays()},
+            {"observers", {"1931", "1964", "2012-2", "2012-10"}},
+            {"spectra", spectral::named_illuminants()}};
+  }
+
+  // One texture layer: light l, bins [4g, 4g + 4) of every pixel as RGBA texels, rows top first.
+  std::string transport(int l, int g, bool half) const {
+    const auto& img = session.image();
+    const int n = img.bins.size();
+    const auto& data = img.lights[static_cast<std::size_t>(l)].data;
+    const std::size_t pixels = img.pixel_count();
+    std::string out(pixels * kBinsPerTexel * (half ? sizeof(std::uint16_t) : sizeof(float)), '\0');
+    for (std::size_t p = 0; p < pixels; ++p) {
+      for (int c = 0; c < kBinsPerTexel; ++c) {
+        const int i = g * kBinsPerTexel + c;
+        const float v = i < n ? data[p * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)] : 0.0f;
+        const std::size_t k = p * kBinsPerTexel + static_cast<std::size_t>(c);
+        if (half) {
+          const std::uint16_t bits = Imath::half(v).bits();
+          std::memcpy(out.data() + k * sizeof bits, &bits, sizeof bits);
+        } else {
+          std::memcpy(out.data() + k * sizeof v, &v, sizeof v);
+        }
+      }
+    }
+    return out;
+  }
+
+  json weights(const RelightSettings& s) const {
+    const RelightMatrix m(session.image().bins, s.lights, s.relight);
+    json lights = json::array();
+    for (int l = 0; l < m.light_count(); ++l) {
+      const Matrix3Xd& w = m.light(l);
+      std::vector<double> rows;  // row-major X, Y, Z rows of n weights
+      for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < m.bin_count(); ++i) rows.push_back(w(c, i));
+      lights.push_back({{"name", session.light_names()[static_cast<std::size_t>(l)]},
+                        {"on", !w.isZero(0.0)},
+                        {"w", rows}});
+    }
+    return {{"state", state_string(s, session)}, {"lights", lights}, {"white", vec3(m.mix_white_xyz())}};
+  }
+
+  // The lights' bin averages times their scales, for the page's plot.
+  json spectra(const RelightSettings& s) const {
+    json lights = json::array();
+    for (std::size_t l = 0; l < s.lights.size(); ++l) {
+      const LightSpec& light = s.lights[l];
+      std::vector<double> v(static_cast<std::size_t>(session.image().bins.size()), 0.0);
+      if (!light.off) {
+        v = light.spectrum.bin_averages(session.image().bins);
+        for (double& x : v) x *= light.scale;
+      }
+      lights.push_back({{"name", session.light_names()[l]}, {"spec", light.text}, {"values", v}});
+    }
+    return {{"lights", lights}};
+  }
+
+  std::string display_shader(const std::string& name) {
+    if (const auto it = display_cache.find(name); it != display_cache.end()) return it->second;
+    spectral::DisplayOptions d = base.output.display;
+    d.colour_space.clear();
+    d.display = name;
+    d.view.clear();
+    const spectral::DisplayShader shader = spectral::DisplayTransform(d).gpu_shader();
+    json uniforms = json::array(), textures = json::array();
+    for (const auto& u : shader.uniforms) uniforms.push_back({{"name", u.name}, {"type", u.type}, {"values", u.values}});
+    for (const auto& t : shader.textures) {
+      textures.push_back({{"name", t.name}, {"sampler", t.sampler}, {"width", t.width}, {"height", t.height},
+                          {"depth", t.depth}, {"channels", t.channels}, {"linear", t.linear}, {"values", t.values}});
+    }
+    const json body = {{"display", name}, {"glsl", shader.glsl}, {"function", shader.function_name},
+                       {"uniforms", uniforms}, {"textures", textures}};
+    return display_cache[name] = body.dump();
+  }
+
+  // Runs a handler, mapping InputError to 400 and any other failure to 500, with a JSON message.
+  template <class F>
+  httplib::Server::Handler guarded(F f) {
+    return [f](const httplib::Request& req, httplib::Response& res) {
+      try {
+        f(req, res);
+      } catch (const InputError& e) {
+        send_json(res, {{"error", e.what()}}, 400);
+      } catch (const std::exception& e) {
+        send_json(res, {{"error", e.what()}}, 500);
+      }
+    };
+  }
+
+  void routes();
+};
+
+void RelightServer::Impl::routes() {
+  server.set_payload_max_length(std::size_t{1} << 16);
+  server.set_read_timeout(10, 0);
+  server.set_keep_alive_max_count(1000);
+  server.set_default_headers({{"Cache-Control", "no-store"},
+                              {"X-Content-Type-Options", "nosniff"},
+                              {"Content-Security-Policy", "default-src 'self'; style-src 'self' 'unsafe-inline'"}});
+  // Bound to loopback, only requests that name a loopback host (no DNS rebinding from other sites).
+  server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    if (!is_loopback_address(opts.bind)) return httplib::Server::HandlerResponse::Unhandled;
+    const std::string host = req.get_header_value("Host");
+    const std::string p = ":" + std::to_string(port);
+    for (const char* h : {"127.0.0.1", "localhost", "[::1]"}) {
+      if (host == h + p) return httplib::Server::HandlerResponse::Unhandled;
+    }
+    send_json(res, {{"error", "Host \"" + host + "\" is not this server's loopback address"}}, 403);
+    return httplib::Server::HandlerResponse::Handled;
+  });
+  server.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
+    if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    send_json(res, {{"error", "HTTP status " + std::to_string(res.status)}}, res.status);
+    return httplib::Server::HandlerResponse::Handled;
+  }));
+
+  for (const char* page : {"/", "/index\\.html"}) {
+    server.Get(page, [](const httplib::Request&, httplib::Response& res) {
+      res.set_content(std::string(detail::web_asset("index.html")), "text/html; charset=utf-8");
+    });
+  }
+  server.Get("/app\\.js", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(detail::web_asset("app.js")), "text/javascript; charset=utf-8");
+  });
+  server.Get("/api/info", guarded([this](const httplib::Request&, httplib::Response& res) {
+    const std::lock_guard lock(mutex);
+    send_json(res, info());
+  }));
+  server.Get("/api/transport", guarded([this](const httplib::Request& req, httplib::Response& res) {
+    const auto& img = session.image();
+    const int l = int_param(req, "light", 0, static_cast<int>(img.lights.size()) - 1);
+    const int g = int_param(req, "group", 0, texel_groups(img.bins.size()) - 1);
+    const std::string type = req.has_param("type") ? req.get_param_value("type") : "f32";
+    if (type != "f32" && type != "f16") throw InputError("type", "expected f32 or f16, not \"" + type + "\"");
+    res.set_content(transport(l, g, type == "f16"), "application/octet-stream");
+  }));
+  server.Get("/api/weights", guarded([this](const httplib::Request& req, httplib::Response& res) {
+    const std::lock_guard lock(mutex);
+    apply_state(req, {});
+    send_json(res, weights(session.settings()));
+  }));
+  server.Get("/api/spectra", guarded([this](const httplib::Request& req, httplib::Response& res) {
+    const std::lock_guard lock(mutex);
+    send_json(res, spectra(settings_of(req, {})));
+  }));
+  server.Get("/api/display", guarded([this](const httplib::Request& req, httplib::Response& res) {
+    if (!req.has_param("name")) throw InputError("name", "missing");
+    const std::lock_guard lock(mutex);
+    res.set_content(display_shader(req.get_param_value("name")), "application/json");
+  }));
+  server.Get("/api/probe", guarded([this](const httplib::Request& req, httplib::Response& res) {
+    const std::lock_guard lock(mutex);
+    const int x = int_param(req, "x", 0, session.image().width - 1);
+    const int y = int_param(req, "y", 0, session.image().height - 1);
+    apply_state(req, {"x", "y"});
+    const ProbeResult p = session.probe(x, y);
+    json bins = json::array();  // in the file's light order
+    for (std::size_t l = 0; l < p.bins.size(); ++l) bins.push_back({{"name", session.light_names()[l]}, {"bins", p.bins[l]}});
+    send_json(res, {{"x", x}, {"y", y}, {"bins", bins}, {"xyz", vec3(p.xyz)}, {"lab", vec3(p.lab)},
+                    {"srgb", vec3(p.srgb)}});
+  }));
+  server.Get("/api/compare", guarded([this](const httplib::Request& req, httplib::Response& res) {
+    const std::lock_guard lock(mutex);
+    const int w = session.image().width - 1, h = session.image().height - 1;
+    const int x1 = int_param(req, "x1", 0, w), y1 = int_param(req, "y1", 0, h);
+    const int x2 = int_param(req, "x2", 0, w), y2 = int_param(req, "y2", 0, h);
+    apply_state(req, {"x1", "y1", "x2", "y2"});
+    const CompareResult c = session.compare(x1, y1, x2, y2);
+    send_json(res, {{"xyz1", vec3(c.xyz1)}, {"xyz2", vec3(c.xyz2)}, {"lab1", vec3(c.lab1)}, {"lab2", vec3(c.lab2)},
+                    {"dE00", c.delta_e2000}});
+  }));
+  server.Post("/api/save", guarded([this](const httplib::Request& req, httplib::Response& res) {
+    if (!req.has_param("file")) throw InputError("file", "missing");
+    const std::string name = req.get_param_value("file");
+    if (!std::regex_match(name, kSaveName)) {
+      throw InputError("file", "\"" + name + "\" is not a plain file name (letters, digits, '.', '_', '-')");
+    }
+    output_format_for(name, "file");
+    const std::lock_guard lock(mutex);
+    apply_state(req, {"file"});
+    const fs::path path = opts.save_dir / name;
+    session.save(path);
+    send_json(res, {{"file", name}, {"path", path.string()}, {"state", state_string(session.settings(), session)}});
+  }));
+}
+
+RelightServer::RelightServer(RelightSession& session, const ServeOptions& opts)
+    : m_impl(std::make_unique<Impl>(session, opts)) {
+  std::error_code ec;
+  if (!fs::is_directory(opts.save_dir, ec)) {
+    throw InputError("--save-dir", "\"" + opts.save_dir.string() + "\" is not an existing folder");
+  }
+  if (::access(opts.save_dir.c_str(), W_OK | X_OK) != 0) {
+    throw InputError("--save-dir", "folder \"" + opts.save_dir.string() + "\" is not writable");
+  }
+  if (opts.port < 0 || opts.port > 65535) {
+    throw InputError("--port", "must be in [0, 65535], not " + std::to_string(opts.port));
+  }
+  session.display();  // the starting display must exist before the page asks for it
+  m_impl->routes();
+  if (opts.port == 0) {
+    m_impl->port = m_impl->server.bind_to_any_port(opts.bind);
+  } else if (m_impl->server.bind_to_port(opts.bind, opts.port)) {
+    m_impl->port = opts.port;
+  } else {
+    m_impl->port = -1;
+  }
+  if (m_impl->port <= 0) {
+    throw spectral::RuntimeError("--bind " + opts.bind + " --port " + std::to_string(opts.port) +
+                                 ": cannot listen there (address not local, or port in use)");
+  }
+}
+
+RelightServer::~RelightServer() { stop(); }
+
+int RelightServer::port() const { return m_impl->port; }
+
+std::string RelightServer::url() const {
+  const std::string& host = m_impl->opts.bind;
+  const bool v6 = host.find(':') != std::string::npos;
+  return "http://" + (v6 ? "[" + host + "]" : host) + ":" + std::to_string(m_impl->port) + "/";
+}
+
+void RelightServer::run() {
+  if (!m_impl->server.listen_after_bind() && m_impl->server.is_running()) {
+    throw spectral::RuntimeError("server on " + url() + " failed");
+  }
+}
+
+void RelightServer::stop() { m_impl->server.stop(); }
+
+namespace {
+
+// SIGINT/SIGTERM → one byte down this pipe (write is async-signal-safe); a watcher thread reads it
+// and stops the server. Works whichever thread the signal lands on (OpenEXR's and TBB's included).
+int g_stop_pipe[2] = {-1, -1};
+
+extern "C" void on_stop_signal(int) {
+  const char byte = 1;
+  [[maybe_unused]] const auto n = ::write(g_stop_pipe[1], &byte, 1);
+}
+
+}  // namespace
+
+void serve_until_signal(RelightServer& server, const std::function<void()>& on_ready) {
+  if (::pipe(g_stop_pipe) != 0) throw spectral::RuntimeError("--serve: cannot create a pipe for signals");
+  struct sigaction action{}, old_int{}, old_term{};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, &old_int);
+  ::sigaction(SIGTERM, &action, &old_term);
+  // httplib's stop() does nothing before listening has begun: repeat it until run() has returned.
+  std::atomic<bool> finished{false};
+  std::thread watcher([&server, &finished] {
+    char byte = 0;
+    while (::read(g_stop_pipe[0], &byte, 1) < 0 && errno == EINTR) {
+    }
+    while (!finished) {
+      server.stop();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+  std::exception_ptr failure;
+  try {
+    if (on_ready) on_ready();
+    server.run();
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  finished = true;
+  on_stop_signal(0);  // the server ended on its own: release the watcher
+  watcher.join();
+  ::sigaction(SIGINT, &old_int, nullptr);
+  ::sigaction(SIGTERM, &old_term, nullptr);
+  ::close(g_stop_pipe[0]);
+  ::close(g_stop_pipe[1]);
+  g_stop_pipe[0] = g_stop_pipe[1] = -1;
+  if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace prizma::relight

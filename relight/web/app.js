@@ -1,0 +1,564 @@
+// prizma-relight --serve: the live relighting page. The transport layers go to the GPU once
+// (RGBA float or half texels, four bins each, one layer of a 2D array texture per light and group
+// of four bins); each change of a control asks the server for the exact relight weights
+// (RelightMatrix, the C++ code of prizma-relight) and the display transform (OpenColorIO's own
+// GLSL), and the fragment shader computes XYZ = Σ_l M_l·T_l then the display. No colour maths here.
+'use strict';
+
+const canvas = document.getElementById('relit');
+const $ = (id) => document.getElementById(id);
+const kPalette = ['#ffb347', '#6ec6ff', '#b6f36b', '#ff6ec7', '#f3e96b', '#c49bff'];
+
+let info = null;       // /api/info
+let gl = null;
+let transportTex = null;
+const programs = {};   // display name → {program, uniforms, textures}
+let frames = 0;
+let uiLights = {};     // light name → control state
+let lastState = '';
+
+// ---------- server calls ----------
+
+async function api(path, query, method) {
+  const r = await fetch(path + (query ? '?' + query : ''), { method: method || 'GET' });
+  const body = await r.json();
+  if (!r.ok) throw new Error(body.error || ('HTTP ' + r.status));
+  return body;
+}
+
+function enc(v) { return encodeURIComponent(v).replace(/%3A/g, ':'); }
+
+// ---------- state: URL fragment ↔ controls ----------
+
+function parseQuery(q) {
+  const out = [];
+  for (const part of q.split('&')) {
+    if (!part) continue;
+    const eq = part.indexOf('=');
+    const k = decodeURIComponent(eq < 0 ? part : part.slice(0, eq));
+    const v = decodeURIComponent(eq < 0 ? '' : part.slice(eq + 1).replace(/\+/g, ' '));
+    out.push([k, v]);
+  }
+  return out;
+}
+
+// A spec → controls: kind (named / blackbody / gaussian / custom), its parameters, scale, on.
+function parseSpec(text, prev) {
+  const l = Object.assign({ on: true, kind: 'named', named: 'D65', temp: 3200, centre: 550, fwhm: 40,
+                            custom: '', scale: 1 }, prev || {});
+  if (text === 'off') { l.on = false; return l; }
+  l.on = true;
+  let base = text, scale = 1, m;
+  while ((m = /^(.*)\*([0-9.eE+-]+)$/.exec(base)) && isFinite(Number(m[2]))) { base = m[1]; scale *= Number(m[2]); }
+  l.scale = scale;
+  if (info.spectra.includes(base)) { l.kind = 'named'; l.named = base; }
+  else if ((m = /^blackbody:([0-9.]+)K?$/i.exec(base))) { l.kind = 'blackbody'; l.temp = Number(m[1]); }
+  else if ((m = /^gaussian:([0-9.]+):([0-9.]+)$/.exec(base))) { l.kind = 'gaussian'; l.centre = Number(m[1]); l.fwhm = Number(m[2]); }
+  else { l.kind = 'custom'; l.custom = base; }
+  return l;
+}
+
+function specOf(l) {
+  if (!l.on) return 'off';
+  let base;
+  switch (l.kind) {
+    case 'named': base = l.named; break;
+    case 'blackbody': base = 'blackbody:' + l.temp + 'K'; break;
+    case 'gaussian': base = 'gaussian:' + l.centre + ':' + l.fwhm; break;
+    default: base = l.custom;
+  }
+  return Number(l.scale) === 1 ? base : base + '*' + l.scale;
+}
+
+// Controls from a fragment: the server's starting state first, then the fragment's keys.
+function stateToControls(fragment) {
+  const s = { exposure: 0, cmf: '1931', display: 'sRGB', adapt: false };
+  for (const [k, v] of parseQuery(info.state).concat(parseQuery(fragment))) {
+    if (k.startsWith('light.')) {
+      const name = k.slice(6);
+      if (name in uiLights) uiLights[name] = parseSpec(v, uiLights[name]);
+    } else if (k === 'exposure') s.exposure = Number(v);
+    else if (k === 'cmf') s.cmf = v;
+    else if (k === 'display') s.display = v;
+    else if (k === 'adapt') s.adapt = v === '1' || v === 'on' || v === 'true';
+  }
+  $('exposure').value = s.exposure; $('exposure_n').value = s.exposure;
+  $('cmf').value = s.cmf; $('display').value = s.display; $('adapt').checked = s.adapt;
+  for (const name of Object.keys(uiLights)) syncLightControls(name);
+  return s;
+}
+
+function controlsToState() {
+  const parts = info.lights.map((l) => 'light.' + enc(l.name) + '=' + enc(specOf(uiLights[l.name])));
+  parts.push('exposure=' + enc(String(Number($('exposure_n').value))));
+  parts.push('cmf=' + enc($('cmf').value));
+  parts.push('display=' + enc($('display').value));
+  parts.push('adapt=' + ($('adapt').checked ? '1' : '0'));
+  return parts.join('&');
+}
+
+function currentFragment() { return location.hash.replace(/^#/, ''); }
+
+function onControlChange() {
+  const frag = controlsToState();
+  history.replaceState(null, '', '#' + frag);
+  requestRender(frag);
+}
+
+// ---------- controls ----------
+
+function slider(label, min, max, step, onInput) {
+  const row = document.createElement('label');
+  row.innerHTML = '<span class="k">' + label + '</span>';
+  const r = document.createElement('input');
+  Object.assign(r, { type: 'range', min, max, step });
+  const n = document.createElement('input');
+  Object.assign(n, { type: 'number', min, max: max * 10, step });
+  r.addEventListener('input', () => { n.value = r.value; onInput(Number(r.value)); });
+  n.addEventListener('change', () => { r.value = n.value; onInput(Number(n.value)); });
+  row.append(r, n);
+  row.set = (v) => { r.value = v; n.value = v; };
+  return row;
+}
+
+function buildLightControls() {
+  const box = $('lights');
+  info.lights.forEach((light, index) => {
+    const name = light.name;
+    uiLights[name] = parseSpec(light.spec);
+    const fs = document.createElement('fieldset');
+    fs.innerHTML = '<legend style="color:' + kPalette[index % kPalette.length] + '">light ' + name + '</legend>';
+    const on = document.createElement('label');
+    on.innerHTML = '<span class="k">on</span>';
+    const onBox = document.createElement('input');
+    onBox.type = 'checkbox';
+    on.append(onBox, document.createTextNode(' default ' + light.default));
+    const kindRow = document.createElement('label');
+    kindRow.innerHTML = '<span class="k">spectrum</span>';
+    const kind = document.createElement('select');
+    for (const s of info.spectra) kind.add(new Option(s, 'named:' + s));
+    kind.add(new Option('blackbody', 'blackbody'));
+    kind.add(new Option('gaussian', 'gaussian'));
+    kind.add(new Option('other spec…', 'custom'));
+    kindRow.append(kind);
+    const l = () => uiLights[name];
+    const temp = slider('temperature K', 1000, 20000, 50, (v) => { l().temp = v; onControlChange(); });
+    const centre = slider('centre nm', 360, 830, 1, (v) => { l().centre = v; onControlChange(); });
+    const fwhm = slider('FWHM nm', 1, 200, 1, (v) => { l().fwhm = v; onControlChange(); });
+    const customRow = document.createElement('label');
+    customRow.innerHTML = '<span class="k">spec</span>';
+    const custom = document.createElement('input');
+    custom.type = 'text';
+    custom.placeholder = 'box:500:560, 0.5, …';
+    customRow.append(custom);
+    const scale = slider('intensity', 0, 4, 0.01, (v) => { l().scale = v; onControlChange(); });
+    fs.append(on, kindRow, temp, centre, fwhm, customRow, scale);
+    box.append(fs);
+
+    onBox.addEventListener('change', () => { l().on = onBox.checked; onControlChange(); });
+    kind.addEventListener('change', () => {
+      const v = kind.value;
+      if (v.startsWith('named:')) { l().kind = 'named'; l().named = v.slice(6); } else l().kind = v;
+      l().on = true;
+      onControlChange();
+    });
+    custom.addEventListener('change', () => { l().custom = custom.value; onControlChange(); });
+    uiLights[name].sync = () => {
+      const s = l();
+      onBox.checked = s.on;
+      kind.value = s.kind === 'named' ? 'named:' + s.named : s.kind;
+      temp.set(s.temp); centre.set(s.centre); fwhm.set(s.fwhm); custom.value = s.custom; scale.set(s.scale);
+      temp.classList.toggle('hidden', s.kind !== 'blackbody');
+      centre.classList.toggle('hidden', s.kind !== 'gaussian');
+      fwhm.classList.toggle('hidden', s.kind !== 'gaussian');
+      customRow.classList.toggle('hidden', s.kind !== 'custom');
+    };
+  });
+}
+
+// parseSpec copies the previous control state, so the control binding (sync) travels with it.
+function syncLightControls(name) { (uiLights[name].sync || (() => {}))(); }
+
+function buildGlobalControls() {
+  for (const d of info.displays) $('display').add(new Option(d, d));
+  $('exposure').addEventListener('input', () => { $('exposure_n').value = $('exposure').value; onControlChange(); });
+  $('exposure_n').addEventListener('change', () => { $('exposure').value = $('exposure_n').value; onControlChange(); });
+  for (const id of ['cmf', 'display', 'adapt']) $(id).addEventListener('change', onControlChange);
+  $('save').addEventListener('click', async () => {
+    try {
+      const r = await api('/api/save', 'file=' + enc($('savename').value) + '&' + (lastState || currentFragment()), 'POST');
+      $('saved').textContent = 'saved ' + r.path;
+    } catch (e) { $('saved').textContent = 'error: ' + e.message; }
+  });
+}
+
+// ---------- WebGL2 ----------
+
+const kVertex = `#version 300 es
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}`;
+
+function fragmentSource(ocio) {
+  const L = info.lights.length, G = info.groups;
+  // Σ_l M_l·T_l written out with constant indices (software GPUs index uniform arrays slowly).
+  let sum = '';
+  for (let l = 0; l < L; ++l) {
+    sum += '  if (u_on[' + l + ']) {\n';
+    for (let g = 0; g < G; ++g) {
+      const k = l * G + g;
+      sum += '    t = texelFetch(u_transport, ivec3(p, ' + k + '), 0);\n' +
+             '    xyz += vec3(dot(u_w[' + 3 * k + '], t), dot(u_w[' + (3 * k + 1) + '], t), dot(u_w[' + (3 * k + 2) +
+             '], t));\n';
+    }
+    sum += '  }\n';
+  }
+  return `#version 300 es
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+precision highp sampler3D;
+precision highp sampler2DArray;
+#define LIGHTS ${L}
+#define GROUPS ${G}
+uniform sampler2DArray u_transport;
+uniform vec4 u_w[3 * LIGHTS * GROUPS];   // per light and group of 4 bins: X, Y, Z weight rows
+uniform bool u_on[LIGHTS];
+uniform int u_height;
+out vec4 fragColor;
+
+// ---- OpenColorIO (GpuShaderDesc, GLSL ES 3.0), as generated for this display ----
+${ocio.glsl}
+// ---- end of OpenColorIO ----
+
+void main() {
+  ivec2 p = ivec2(int(gl_FragCoord.x), u_height - 1 - int(gl_FragCoord.y));
+  vec3 xyz = vec3(0.0);
+  vec4 t;
+${sum}
+  // As the CPU path: non-finite values become 0, the display output is clamped to [0, 1].
+  for (int c = 0; c < 3; ++c) if (isnan(xyz[c]) || isinf(xyz[c])) xyz[c] = 0.0;
+  vec4 rgb = ${ocio.function}(vec4(xyz, 1.0));
+  fragColor = vec4(clamp(rgb.rgb, 0.0, 1.0), 1.0);
+}`;
+}
+
+function compile(type, src) {
+  const s = gl.createShader(type);
+  gl.shaderSource(s, src);
+  gl.compileShader(s);
+  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error('shader: ' + gl.getShaderInfoLog(s));
+  return s;
+}
+
+async function programFor(display) {
+  if (programs[display]) return programs[display];
+  const ocio = await api('/api/display', 'name=' + enc(display));
+  const prog = gl.createProgram();
+  gl.attachShader(prog, compile(gl.VERTEX_SHADER, kVertex));
+  gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, fragmentSource(ocio)));
+  gl.linkProgram(prog);
+  if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error('link: ' + gl.getProgramInfoLog(prog));
+  gl.useProgram(prog);
+  gl.uniform1i(gl.getUniformLocation(prog, 'u_transport'), 0);
+  gl.uniform1i(gl.getUniformLocation(prog, 'u_height'), info.height);
+  // OCIO's uniforms (dynamic properties) and LUT textures, as OCIO described them.
+  for (const u of ocio.uniforms) {
+    const loc = gl.getUniformLocation(prog, u.name);
+    if (u.type === 'double') gl.uniform1f(loc, u.values[0]);
+    else if (u.type === 'bool') gl.uniform1i(loc, u.values[0] ? 1 : 0);
+    else if (u.type === 'float3') gl.uniform3fv(loc, u.values);
+    else if (u.type === 'vector_float') gl.uniform1fv(loc, u.values);
+    else if (u.type === 'vector_int') gl.uniform1iv(loc, u.values);
+  }
+  const textures = ocio.textures.map((t, i) => {
+    const tex = gl.createTexture();
+    const target = t.depth > 0 ? gl.TEXTURE_3D : gl.TEXTURE_2D;
+    gl.activeTexture(gl.TEXTURE1 + i);
+    gl.bindTexture(target, tex);
+    const fmt = t.channels === 1 ? [gl.R32F, gl.RED] : [gl.RGB32F, gl.RGB];
+    const data = new Float32Array(t.values);
+    if (t.depth > 0) gl.texImage3D(target, 0, fmt[0], t.width, t.height, t.depth, 0, fmt[1], gl.FLOAT, data);
+    else gl.texImage2D(target, 0, fmt[0], t.width, t.height, 0, fmt[1], gl.FLOAT, data);
+    const filter = t.linear && gl.getExtension('OES_texture_float_linear') ? gl.LINEAR : gl.NEAREST;
+    gl.texParameteri(target, gl.TEXTURE_MIN_FILTER, filter);
+    gl.texParameteri(target, gl.TEXTURE_MAG_FILTER, filter);
+    for (const w of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T, gl.TEXTURE_WRAP_R]) gl.texParameteri(target, w, gl.CLAMP_TO_EDGE);
+    gl.uniform1i(gl.getUniformLocation(prog, t.sampler), 1 + i);
+    return { tex, target };
+  });
+  gl.activeTexture(gl.TEXTURE0);
+  programs[display] = {
+    prog, textures,
+    w: gl.getUniformLocation(prog, 'u_w'),
+    on: gl.getUniformLocation(prog, 'u_on'),
+  };
+  return programs[display];
+}
+
+function setupGL() {
+  gl = canvas.getContext('webgl2', { antialias: false, depth: false, stencil: false, alpha: false,
+                                     preserveDrawingBuffer: true, premultipliedAlpha: false });
+  if (!gl) throw new Error('this browser has no WebGL2');
+  canvas.width = info.width;
+  canvas.height = info.height;
+  // Shown at an integer zoom (pixels stay square) that fits the view, or scaled down to fit it.
+  const room = Math.max(200, $('view').clientWidth);
+  const zoom = info.width <= room ? Math.min(8, Math.floor(room / info.width)) : room / info.width;
+  canvas.style.width = Math.round(info.width * zoom) + 'px';
+  canvas.style.height = Math.round(info.height * zoom) + 'px';
+  const layers = info.lights.length * info.groups;
+  const need = 3 * layers + 8;
+  if (need > gl.getParameter(gl.MAX_FRAGMENT_UNIFORM_VECTORS)) {
+    throw new Error(layers * 4 + ' bins × lights need ' + need + ' uniform vectors, this GPU has ' +
+                    gl.getParameter(gl.MAX_FRAGMENT_UNIFORM_VECTORS));
+  }
+  if (layers > gl.getParameter(gl.MAX_ARRAY_TEXTURE_LAYERS) ||
+      Math.max(info.width, info.height) > gl.getParameter(gl.MAX_TEXTURE_SIZE)) {
+    throw new Error('the image is larger than this GPU\'s textures');
+  }
+}
+
+// Texel type: float32 unless ?texture=f16 or the float layers would pass 512 MB.
+function textureType() {
+  const q = new URLSearchParams(location.search).get('texture');
+  if (q === 'f16' || q === 'f32') return q;
+  const bytes = info.width * info.height * 16 * info.lights.length * info.groups;
+  return bytes > 512 * 1024 * 1024 ? 'f16' : 'f32';
+}
+
+async function uploadTransport() {
+  const type = textureType();
+  const half = type === 'f16';
+  transportTex = gl.createTexture();
+  gl.activeTexture(gl.TEXTURE0);
+  gl.bindTexture(gl.TEXTURE_2D_ARRAY, transportTex);
+  const layers = info.lights.length * info.groups;
+  gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, half ? gl.RGBA16F : gl.RGBA32F, info.width, info.height, layers);
+  gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+  gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  for (let l = 0; l < info.lights.length; ++l) {
+    for (let g = 0; g < info.groups; ++g) {
+      $('title').textContent = 'loading transport ' + (l * info.groups + g + 1) + '/' + layers + ' (' + type + ')';
+      const r = await fetch('/api/transport?light=' + l + '&group=' + g + '&type=' + type);
+      if (!r.ok) throw new Error('transport: HTTP ' + r.status);
+      const buf = await r.arrayBuffer();
+      const data = half ? new Uint16Array(buf) : new Float32Array(buf);
+      gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, l * info.groups + g, info.width, info.height, 1, gl.RGBA,
+                       half ? gl.HALF_FLOAT : gl.FLOAT, data);
+    }
+  }
+  canvas.dataset.texture = type;
+}
+
+let currentWeights = null;   // Float32Array for u_w
+let currentOn = null;
+let currentProgram = null;
+
+function setWeights(w) {
+  const L = info.lights.length, G = info.groups, n = info.bins.length - 1;
+  const u = new Float32Array(3 * L * G * 4);
+  const on = new Int32Array(L);
+  w.lights.forEach((light, l) => {
+    on[l] = light.on ? 1 : 0;
+    for (let c = 0; c < 3; ++c)
+      for (let i = 0; i < n; ++i) {
+        const g = Math.floor(i / 4);
+        u[((l * G + g) * 3 + c) * 4 + (i % 4)] = light.w[c * n + i];
+      }
+  });
+  currentWeights = u;
+  currentOn = on;
+}
+
+function draw() {
+  const p = currentProgram;
+  gl.viewport(0, 0, info.width, info.height);
+  gl.useProgram(p.prog);
+  gl.uniform4fv(p.w, currentWeights);
+  gl.uniform1iv(p.on, currentOn);
+  gl.activeTexture(gl.TEXTURE0);
+  gl.bindTexture(gl.TEXTURE_2D_ARRAY, transportTex);
+  p.textures.forEach((t, i) => { gl.activeTexture(gl.TEXTURE1 + i); gl.bindTexture(t.target, t.tex); });
+  gl.activeTexture(gl.TEXTURE0);
+  gl.drawArrays(gl.TRIANGLES, 0, 3);
+}
+
+// ---------- render loop: one request in flight, the latest state wins ----------
+
+let pending = null;
+let busy = false;
+
+function requestRender(fragment) {
+  pending = fragment;
+  if (!busy) pump();
+}
+
+async function pump() {
+  busy = true;
+  while (pending !== null) {
+    const frag = pending;
+    pending = null;
+    try {
+      const display = stateDisplay(frag);
+      const [w, prog] = await Promise.all([api('/api/weights', frag), programFor(display)]);
+      setWeights(w);
+      currentProgram = prog;
+      draw();
+      frames += 1;
+      lastState = frag;
+      canvas.dataset.frame = String(frames);
+      canvas.dataset.state = frag;
+      delete canvas.dataset.error;
+      $('status').textContent = '';
+      plotSpectra(frag);
+      if (hover) probe(hover.x, hover.y);
+      if (picks.length === 2) compare();
+    } catch (e) {
+      canvas.dataset.error = e.message;
+      $('status').textContent = e.message;
+    }
+  }
+  busy = false;
+}
+
+function stateDisplay(frag) {
+  let d = 'sRGB';
+  for (const [k, v] of parseQuery(info.state).concat(parseQuery(frag))) if (k === 'display') d = v;
+  return d;
+}
+
+// ---------- plots, probe, compare ----------
+
+function plotSteps(ctx, series, w, h, labels) {
+  ctx.clearRect(0, 0, w, h);
+  const edges = info.bins;
+  const lo = edges[0], hi = edges[edges.length - 1];
+  let max = 0;
+  for (const s of series) for (const v of s.values) max = Math.max(max, v);
+  if (!(max > 0)) max = 1;
+  const X = (nm) => 4 + (w - 8) * (nm - lo) / (hi - lo || 1);
+  const Y = (v) => h - 14 - (h - 22) * v / max;
+  ctx.strokeStyle = '#555';
+  ctx.fillStyle = '#888';
+  ctx.font = '10px sans-serif';
+  ctx.beginPath(); ctx.moveTo(4, h - 14); ctx.lineTo(w - 4, h - 14); ctx.stroke();
+  ctx.fillText(lo.toFixed(0) + ' nm', 4, h - 2);
+  ctx.fillText(hi.toFixed(0) + ' nm', w - 40, h - 2);
+  series.forEach((s, k) => {
+    ctx.strokeStyle = s.colour;
+    ctx.beginPath();
+    for (let i = 0; i < s.values.length; ++i) {
+      const y = Y(s.values[i]);
+      if (i === 0) ctx.moveTo(X(edges[0]), y); else ctx.lineTo(X(edges[i]), y);
+      ctx.lineTo(X(edges[i + 1]), y);
+    }
+    ctx.stroke();
+    if (labels) { ctx.fillStyle = s.colour; ctx.fillText(s.label, 8 + 70 * k, 10); }
+  });
+}
+
+let spectraBusy = false;
+async function plotSpectra(frag) {
+  if (spectraBusy) return;
+  spectraBusy = true;
+  try {
+    const r = await api('/api/spectra', frag);
+    const c = $('spectra');
+    plotSteps(c.getContext('2d'), r.lights.map((l, k) => ({ values: l.values, colour: kPalette[k % kPalette.length],
+                                                              label: l.name })), c.width, c.height, true);
+  } catch (e) { /* the frame's own request reports errors */ } finally { spectraBusy = false; }
+}
+
+let hover = null;
+let probeBusy = false;
+const picks = [];
+
+function pixelOf(ev) {
+  const r = canvas.getBoundingClientRect();
+  const x = Math.floor((ev.clientX - r.left) / r.width * info.width);
+  const y = Math.floor((ev.clientY - r.top) / r.height * info.height);
+  return { x: Math.min(Math.max(x, 0), info.width - 1), y: Math.min(Math.max(y, 0), info.height - 1) };
+}
+
+const f3 = (v, d) => v.map((x) => x.toFixed(d === undefined ? 4 : d)).join(' ');
+
+async function probe(x, y) {
+  if (probeBusy) return;
+  probeBusy = true;
+  try {
+    const r = await api('/api/probe', 'x=' + x + '&y=' + y + '&' + lastState);
+    $('probe').textContent = 'pixel (' + x + ', ' + y + ')   sRGB ' + f3(r.srgb) + '   Lab ' + f3(r.lab, 2) +
+                             '   XYZ ' + f3(r.xyz);
+    const c = $('probeplot');
+    plotSteps(c.getContext('2d'), r.bins.map((l, k) => ({ values: l.bins, colour: kPalette[k % kPalette.length],
+                                                          label: 'T ' + l.name })), c.width, c.height, true);
+  } catch (e) { $('probe').textContent = e.message; } finally { probeBusy = false; }
+}
+
+async function compare() {
+  const [a, b] = picks;
+  try {
+    const r = await api('/api/compare', 'x1=' + a.x + '&y1=' + a.y + '&x2=' + b.x + '&y2=' + b.y + '&' + lastState);
+    $('compare').textContent = 'A (' + a.x + ', ' + a.y + ') Lab ' + f3(r.lab1, 2) + '\nB (' + b.x + ', ' + b.y +
+                               ') Lab ' + f3(r.lab2, 2) + '\nΔE00 ' + r.dE00.toFixed(3);
+  } catch (e) { $('compare').textContent = e.message; }
+}
+
+canvas.addEventListener('mousemove', (ev) => { if (!info) return; hover = pixelOf(ev); probe(hover.x, hover.y); });
+canvas.addEventListener('click', (ev) => {
+  if (!info) return;
+  if (picks.length === 2) picks.length = 0;
+  picks.push(pixelOf(ev));
+  ['markA', 'markB'].forEach((id, k) => {
+    const m = $(id);
+    m.classList.toggle('hidden', k >= picks.length);
+    if (k < picks.length) {
+      m.style.left = ((picks[k].x + 0.5) / info.width * canvas.clientWidth) + 'px';
+      m.style.top = ((picks[k].y + 0.5) / info.height * canvas.clientHeight) + 'px';
+    }
+  });
+  if (picks.length === 2) compare();
+  else $('compare').textContent = 'A (' + picks[0].x + ', ' + picks[0].y + '): click a second pixel';
+});
+
+// ---------- frame timing (bench/live-page): n draws, each synchronised by a 1-pixel readPixels ----------
+
+window.prizmaBench = {
+  drawTimed(n) {
+    const px = new Uint8Array(4);
+    draw(); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    const t0 = performance.now();
+    for (let i = 0; i < n; ++i) { draw(); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px); }
+    return (performance.now() - t0) / n;
+  },
+};
+
+// ---------- start ----------
+
+async function main() {
+  try {
+    info = await api('/api/info');
+    $('title').textContent = info.source + ' — ' + info.width + '×' + info.height + ', ' + (info.bins.length - 1) +
+                             ' bins ' + info.bins[0] + '–' + info.bins[info.bins.length - 1] + ' nm, lights ' +
+                             info.lights.map((l) => l.name).join(', ');
+    buildLightControls();
+    buildGlobalControls();
+    setupGL();
+    await uploadTransport();
+    $('title').textContent = info.source + ' — ' + info.width + '×' + info.height + ', ' + (info.bins.length - 1) +
+                             ' bins, lights ' + info.lights.map((l) => l.name).join(', ') + ' (prizma ' +
+                             info.version + ')';
+    window.addEventListener('hashchange', () => { stateToControls(currentFragment()); requestRender(currentFragment()); });
+    if (!currentFragment()) history.replaceState(null, '', '#' + info.state);
+    stateToControls(currentFragment());
+    requestRender(currentFragment());
+  } catch (e) {
+    canvas.dataset.error = e.message;
+    $('status').textContent = e.message;
+  }
+}
+
+main();

@@ -1,0 +1,25 @@
+# prizma-relight --serve: the HTTP server's answers to bad requests (label "serve"), and the live page
+# in headless Chromium against prizma-relight -o (label "browser"; skipped, exit 77, when chromium,
+# chromium-driver or python3-selenium are missing). Driver: browser/live_page_test.py.
+if(NOT TARGET prizma-relight)
+  return()
+endif()
+
+add_executable(prizma_live_page_fixture ${PRIZMA_E2E_DIR}/browser/make_fixture.cpp)
+target_link_libraries(prizma_live_page_fixture PRIVATE prizma::spectral)
+prizma_set_warnings(prizma_live_page_fixture)
+
+set(_live_work ${PRIZMA_E2E_WORK}/live_page)
+add_test(NAME relight.live.fixture COMMAND prizma_live_page_fixture ${_live_work})
+set_tests_properties(relight.live.fixture PROPERTIES FIXTURES_SETUP live_page_files)
+
+foreach(mode server browser)
+  add_test(NAME relight.live.${mode}
+           COMMAND /usr/bin/python3 ${PRIZMA_E2E_DIR}/browser/live_page_test.py ${mode}
+                   $<TARGET_FILE:prizma-relight> ${_live_work})
+  set_tests_properties(relight.live.${mode} PROPERTIES FIXTURES_REQUIRED live_page_files
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}" RESOURCE_LOCK live_page_work
+                       TIMEOUT 300 SKIP_RETURN_CODE 77)
+endforeach()
+set_tests_properties(relight.live.server PROPERTIES LABELS serve)
+set_tests_properties(relight.live.browser PROPERTIES LABELS browser)
