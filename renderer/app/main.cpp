@@ -19,6 +19,8 @@
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/tool_main.h"
 
+PRIZMA_TOOL_STARTUP_GUARD("prizma-render");
+
 namespace {
 
 using prizma::spectral::InputError;
@@ -42,6 +44,8 @@ struct Options {
   std::optional<int> width, height;
   std::string bins;
   std::optional<std::uint64_t> seed;
+  // As typed: checked by the scene loader against exactly the scene field's range.
+  std::optional<std::string> spp_text, width_text, height_text, seed_text;
   std::string samples;
   int threads = 0;
   std::string wavelength_sampling;
@@ -160,12 +164,11 @@ int main(int argc, char** argv) {
   Options o;
   app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md)")->required();
   app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")");
-  app.add_option("--spp", o.spp, "samples per pixel (renders samples [begin, begin + N))")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--width", o.width, "image width in pixels")->check(CLI::PositiveNumber);
-  app.add_option("--height", o.height, "image height in pixels")->check(CLI::PositiveNumber);
+  app.add_option("--spp", o.spp_text, "samples per pixel (renders samples [begin, begin + N))");
+  app.add_option("--width", o.width_text, "image width in pixels");
+  app.add_option("--height", o.height_text, "image height in pixels");
   app.add_option("--bins", o.bins, "bin layout: linear:400:700:12, exp:400:700:12:1.5, edges:400,450,500");
-  app.add_option("--seed", o.seed, "random seed");
+  app.add_option("--seed", o.seed_text, "random seed");
   app.add_option("--samples", o.samples, "sample range A:B of every pixel (for shards; merge them later)");
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_option("--wavelength-sampling", o.wavelength_sampling,
@@ -186,7 +189,12 @@ int main(int argc, char** argv) {
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   return spectral::run_tool(kProgram, [&] {
-    render::Scene scene = render::load_scene(o.scene);
+    if (o.spp_text) o.spp = render::scene_integer_override(*o.spp_text, "samples", "--spp");
+    if (o.width_text) o.width = static_cast<int>(render::scene_integer_override(*o.width_text, "camera.width", "--width"));
+    if (o.height_text) o.height = static_cast<int>(render::scene_integer_override(*o.height_text, "camera.height", "--height"));
+    if (o.seed_text) o.seed = render::scene_seed_override(*o.seed_text, "--seed");
+    render::Scene scene =
+        spectral::allocating("reading the scene and its volume", [&] { return render::load_scene(o.scene); });
     auto& st = scene.settings;
     if (o.width) scene.camera.width = *o.width;
     if (o.height) scene.camera.height = *o.height;
@@ -243,7 +251,10 @@ int main(int argc, char** argv) {
     cb.cancel = &g_cancel;
     cb.progress = [&](const render::RenderProgress& p) { bar.update(p); };
     render::RenderStats stats;
-    spectral::SpectralImage image = render::render(scene, cb, &stats);
+    spectral::SpectralImage image = spectral::allocating(
+        "rendering (" + std::to_string(scene.camera.width) + "×" + std::to_string(scene.camera.height) + " pixels × " +
+            std::to_string(scene.lights.size()) + " lights × " + std::to_string(st.bins.size()) + " bins)",
+        [&] { return render::render(scene, cb, &stats); });
     bar.finish();
     if (previous) image = render::merge_shards({*previous, image});
 
