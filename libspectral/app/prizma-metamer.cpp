@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -16,6 +17,7 @@
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
 #include "prizma/spectral/light_design.h"
 #include "prizma/spectral/metamer_design.h"
 #include "prizma/spectral/spectrum_spec.h"
@@ -89,11 +91,14 @@ ps::Spectrum parse_option(const std::string& spec, const std::string& option) {
 // The albedo of a material of a scene file: `materials` as an array of objects with "name" (or
 // looked up by index) or as an object keyed by name; "albedo" a spec string or a number.
 ps::Spectrum scene_albedo(const std::filesystem::path& scene_path, const std::string& material) {
-  std::ifstream in(scene_path);
+  ps::require_regular_file(scene_path, "a scene file");
+  std::ifstream in(scene_path, std::ios::binary);
   if (!in) throw ps::InputError(scene_path.string(), "cannot open the scene file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ps::check_json_depth(text, scene_path.string());
   nlohmann::json scene;
   try {
-    scene = nlohmann::json::parse(in);
+    scene = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw ps::InputError(scene_path.string(), std::string("not valid JSON: ") + e.what());
   }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
 #include "text_util.h"
 
 namespace prizma::spectral::detail {
@@ -58,8 +59,7 @@ inline std::string_view strip_comment(std::string_view line) {
 inline CsvTable read_csv_table(const std::filesystem::path& path, std::size_t min_columns,
                                std::size_t exact_columns = 0) {
   const std::string name = path.string();
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(name, "is a folder, not a CSV file");
+  require_regular_file(path, "a CSV file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(name, "cannot open file for reading");
   CsvTable t;

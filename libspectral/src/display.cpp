@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -88,6 +89,10 @@ DisplayTransform::DisplayTransform(const DisplayOptions& opts) : m_impl(std::mak
     impl.config = OCIO::Config::CreateFromFile(cfg.c_str());
     impl.config->validate();
   } catch (const OCIO::Exception& e) {
+    // OCIO wraps a failed allocation in its own exception: that is not the config's fault.
+    if (std::string_view(e.what()).find("bad_alloc") != std::string_view::npos) {
+      throw RuntimeError(cfg + ": out of memory loading the OCIO config (" + e.what() + ")");
+    }
     throw InputError(cfg, std::string("cannot load OCIO config: ") + e.what());
   }
 

@@ -11,7 +11,11 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
 #include <ImfIntAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfVecAttribute.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 #include <ImfThreading.h>
@@ -36,11 +40,13 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
 #include "prizma/spectral/tool_main.h"
 #include "text_util.h"
 
@@ -435,6 +441,12 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {
+      // OpenEXR's threads that cannot start (EAGAIN) or allocate: out of memory, said so.
+      const std::string what = e.what();
+      if (is_out_of_memory(e) || what.find("Resource temporarily unavailable") != std::string::npos ||
+          what.find("ut of memory") != std::string::npos || what.find("bad_alloc") != std::string::npos) {
+        throw RuntimeError(p + ": out of memory writing the OpenEXR file (" + what + ")");
+      }
       throw RuntimeError(p + ": cannot write OpenEXR file: " + e.what());
     }
   });
@@ -587,6 +599,33 @@ std::string describe_lambdas(const std::vector<double>& l) {
 }
 
 // Reads one layer's channels into a pixel-major, bin-contiguous buffer.
+// prizma:binEdgesNm in any numeric form OpenEXR holds: Prizma writes a float vector, but
+// OpenImageIO (oiiotool) rewrites a float array of 2, 3, 9 or 16 values as v2f, v3f, m33f or
+// m44f, and other tools may write doubles. Empty when absent; InputError for any other type.
+std::optional<std::vector<double>> edges_attribute(const Imf::Header& h, const char* name, const std::string& p) {
+  const auto it = h.find(name);
+  if (it == h.end()) return std::nullopt;
+  const Imf::Attribute* attr = &it.attribute();
+  std::vector<double> v;
+  auto take = [&](const auto* values, std::size_t n) { v.assign(values, values + n); };
+  if (const auto* a = dynamic_cast<const Imf::FloatVectorAttribute*>(attr)) take(a->value().data(), a->value().size());
+  else if (const auto* a2f = dynamic_cast<const Imf::V2fAttribute*>(attr)) take(&a2f->value()[0], 2);
+  else if (const auto* a3f = dynamic_cast<const Imf::V3fAttribute*>(attr)) take(&a3f->value()[0], 3);
+  else if (const auto* m3f = dynamic_cast<const Imf::M33fAttribute*>(attr)) take(&m3f->value()[0][0], 9);
+  else if (const auto* m4f = dynamic_cast<const Imf::M44fAttribute*>(attr)) take(&m4f->value()[0][0], 16);
+  else if (const auto* a2d = dynamic_cast<const Imf::V2dAttribute*>(attr)) take(&a2d->value()[0], 2);
+  else if (const auto* a3d = dynamic_cast<const Imf::V3dAttribute*>(attr)) take(&a3d->value()[0], 3);
+  else if (const auto* m3d = dynamic_cast<const Imf::M33dAttribute*>(attr)) take(&m3d->value()[0][0], 9);
+  else if (const auto* m4d = dynamic_cast<const Imf::M44dAttribute*>(attr)) take(&m4d->value()[0][0], 16);
+  else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(attr)) v = {f->value()};
+  else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(attr)) v = {d->value()};
+  else {
+    throw InputError(p, std::string(name) + " has type " + attr->typeName() +
+                            "; expected the bin edges as floats (floatvector, v2f, v3f, m33f, m44f or doubles)");
+  }
+  return v;
+}
+
 void add_slices(Imf::FrameBuffer& fb, const LayerChannels& layer, std::vector<float>& dest,
                 const Imath::Box2i& dw, int bins) {
   const std::size_t x_stride = sizeof(float) * static_cast<std::size_t>(bins);
@@ -601,9 +640,7 @@ void add_slices(Imf::FrameBuffer& fb, const LayerChannels& layer, std::vector<fl
 
 SpectralImage read_spectral_exr(const fs::path& path) {
   const std::string p = path_string(path);
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(p, "file does not exist");
-  if (fs::is_directory(path, ec)) throw InputError(p, "is a folder, not an OpenEXR file");
+  require_regular_file(path, "an OpenEXR file");
   if (!Imf::isOpenExrFile(p.c_str())) throw InputError(p, "not an OpenEXR file");
   check_header_sizes(p);
 
@@ -661,6 +698,7 @@ SpectralImage read_spectral_exr(const fs::path& path) {
     info.seed = int_attr(header, kAttrSeed, p);
     nlohmann::json lights_json;
     if (!info.lights_json.empty()) {
+      check_json_depth(info.lights_json, p + ": " + kAttrLights);
       lights_json = nlohmann::json::parse(info.lights_json, nullptr, /*allow_exceptions=*/false);
       if (lights_json.is_discarded()) throw InputError(p, std::string(kAttrLights) + " is not valid JSON");
     }
@@ -727,8 +765,8 @@ SpectralImage read_spectral_exr(const fs::path& path) {
 
     // Bin edges: prizma:binEdgesNm (checked against the centres), else midpoints between centres.
     std::vector<double> edges;
-    if (const auto* a = header.findTypedAttribute<Imf::FloatVectorAttribute>(kAttrEdges)) {
-      const auto& fe = a->value();
+    if (const auto recorded = edges_attribute(header, kAttrEdges, p)) {
+      const std::vector<double>& fe = *recorded;
       if (fe.size() != static_cast<std::size_t>(n) + 1) {
         throw InputError(p, std::string(kAttrEdges) + " has " + std::to_string(fe.size()) + " edges for " +
                                 std::to_string(n) + " spectral channels (expected " + std::to_string(n + 1) + ")");
@@ -743,7 +781,9 @@ SpectralImage read_spectral_exr(const fs::path& path) {
           exact.push_back(v);
         }
         bool agree = exact.size() == edges.size();
-        for (std::size_t i = 0; agree && i < exact.size(); ++i) agree = static_cast<float>(exact[i]) == fe[i];
+        for (std::size_t i = 0; agree && i < exact.size(); ++i) {
+          agree = static_cast<float>(exact[i]) == static_cast<float>(fe[i]) || exact[i] == fe[i];
+        }
         if (agree) edges = exact;
       }
       for (int i = 0; i < n; ++i) {
@@ -754,6 +794,18 @@ SpectralImage read_spectral_exr(const fs::path& path) {
              << " (centre " << lambdas[static_cast<std::size_t>(i)] << " nm) is not inside its bin ["
              << edges[static_cast<std::size_t>(i)] << ", " << edges[static_cast<std::size_t>(i) + 1] << "] nm of "
              << kAttrEdges;
+          throw InputError(p, os.str());
+        }
+        // Prizma names each channel after its bin's centre (6 decimals); float edges are within
+        // 4e-5 nm of the exact ones up to 830 nm.
+        const double centre = 0.5 * (edges[static_cast<std::size_t>(i)] + edges[static_cast<std::size_t>(i) + 1]);
+        if (!(std::abs(centre - lambdas[static_cast<std::size_t>(i)]) <= 1e-4)) {
+          std::ostringstream os;
+          os.precision(10);
+          os << "channel " << layers.at(sources.front().layer).channels[static_cast<std::size_t>(i)].second << " ("
+             << lambdas[static_cast<std::size_t>(i)] << " nm) is not the centre " << centre << " nm of its bin ["
+             << edges[static_cast<std::size_t>(i)] << ", " << edges[static_cast<std::size_t>(i) + 1] << "] nm of "
+             << kAttrEdges << ": the recorded edges disagree with the channels";
           throw InputError(p, os.str());
         }
       }
@@ -811,9 +863,19 @@ SpectralImage read_spectral_exr(const fs::path& path) {
   } catch (const InputError&) {
     throw;
   } catch (const std::bad_alloc&) {
-    throw;
+    throw RuntimeError(p + ": out of memory reading the file's header and pixels");
+  } catch (const std::system_error& e) {
+    if (is_out_of_resources(e)) throw RuntimeError(p + ": out of memory starting OpenEXR's threads (" + e.what() + ")");
+    throw InputError(p, std::string("cannot read OpenEXR file (truncated or corrupt?): ") + e.what());
   } catch (const std::exception& e) {
-    // OpenEXR (Iex) exceptions: truncated or corrupt files.
+    // OpenEXR (Iex) exceptions: truncated or corrupt files. Its worker threads report a failed
+    // allocation as an Iex message ("Out of memory", "std::bad_alloc"): that is not the file's fault.
+    const std::string what = e.what();
+    if (what.find("ut of memory") != std::string::npos || what.find("bad_alloc") != std::string::npos ||
+        what.find("Cannot allocate memory") != std::string::npos ||
+        what.find("Resource temporarily unavailable") != std::string::npos) {
+      throw RuntimeError(p + ": out of memory reading the pixels (" + what + ")");
+    }
     throw InputError(p, std::string("cannot read OpenEXR file (truncated or corrupt?): ") + e.what());
   }
 }

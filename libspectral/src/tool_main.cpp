@@ -1,12 +1,19 @@
 #include "prizma/spectral/tool_main.h"
 
+#include <signal.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <iostream>
 #include <new>
+#include <string_view>
+#include <system_error>
 
 #include "prizma/spectral/error.h"
 
@@ -27,6 +34,88 @@ std::string prizma_version() {
   return v;
 }
 
+bool is_out_of_resources(const std::system_error& e) {
+  return e.code() == std::errc::resource_unavailable_try_again || e.code() == std::errc::not_enough_memory;
+}
+
+bool is_out_of_memory(const std::exception& e) {
+  if (dynamic_cast<const RuntimeError*>(&e) != nullptr) return false;  // already says what it is
+  if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr) return true;
+  if (const auto* s = dynamic_cast<const std::system_error*>(&e)) return is_out_of_resources(*s);
+  return std::string_view(e.what()).find("pthread_create has failed") != std::string_view::npos;
+}
+
+void report_uncaught_and_exit(const char* program) noexcept {
+  // stdio only and no allocation: this may run before the C++ library's own initialisation
+  // (iostreams), and memory may be exhausted.
+  const char* reason = "unknown failure";
+  const char* detail = "";
+  try {
+    if (const std::exception_ptr e = std::current_exception()) std::rethrow_exception(e);
+    reason = "terminated (no exception)";
+  } catch (const std::bad_alloc&) {
+    reason = "out of memory (while a library started up or shut down, outside Prizma's code)";
+  } catch (const std::system_error& e) {
+    reason = is_out_of_resources(e) ? "out of memory: a library cannot start its threads before main: " : "";
+    detail = e.what();
+  } catch (const std::exception& e) {
+    reason = "";
+    detail = e.what();
+  } catch (...) {
+  }
+  std::fprintf(stderr, "%s: error: %s%s\n", program, reason, detail);
+  std::fflush(stderr);
+  std::_Exit(kExitRuntime);
+}
+
+namespace {
+const char* g_startup_program = nullptr;
+struct sigaction g_old_segv {};
+struct sigaction g_old_bus {};
+bool g_guard_active = false;
+stack_t g_old_altstack{};
+bool g_altstack_set = false;
+
+extern "C" void on_startup_crash(int) {
+  // Async-signal-safe only: write(2) and _exit.
+  static const char kMsg[] =
+      ": error: out of memory: a library crashed while starting up, before main (its allocation failed under the "
+      "address-space limit)\n";
+  static const char kOther[] = ": error: a library crashed while starting up, before main (SIGSEGV)\n";
+  rlimit lim{};
+  const bool limited = ::getrlimit(RLIMIT_AS, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY;
+  const char* p = g_startup_program != nullptr ? g_startup_program : "prizma";
+  std::size_t n = 0;
+  while (p[n] != '\0') ++n;
+  [[maybe_unused]] ssize_t w = ::write(STDERR_FILENO, p, n);
+  w = limited ? ::write(STDERR_FILENO, kMsg, sizeof kMsg - 1) : ::write(STDERR_FILENO, kOther, sizeof kOther - 1);
+  ::_exit(kExitRuntime);
+}
+}  // namespace
+
+void begin_startup_guard(const char* program) noexcept {
+  g_startup_program = program;
+  // On its own stack: the crash may be the main stack failing to grow under the limit.
+  alignas(16) static char alt_stack[1 << 16];
+  stack_t ss{};
+  ss.ss_sp = alt_stack;
+  ss.ss_size = sizeof alt_stack;
+  g_altstack_set = ::sigaltstack(&ss, &g_old_altstack) == 0;
+  struct sigaction sa {};
+  sa.sa_handler = on_startup_crash;
+  sa.sa_flags = SA_ONSTACK;
+  sigemptyset(&sa.sa_mask);
+  g_guard_active = ::sigaction(SIGSEGV, &sa, &g_old_segv) == 0 && ::sigaction(SIGBUS, &sa, &g_old_bus) == 0;
+}
+
+void end_startup_guard() noexcept {
+  if (!g_guard_active) return;
+  ::sigaction(SIGSEGV, &g_old_segv, nullptr);
+  ::sigaction(SIGBUS, &g_old_bus, nullptr);
+  if (g_altstack_set) ::sigaltstack(&g_old_altstack, nullptr);  // the sanitizers' own, if any
+  g_guard_active = false;
+}
+
 int check_standard_output(const std::string& program, int rc) {
   // std::cout is synchronised with stdio (the default), so both end in stdout's buffer; flush it
   // first, while the reason of a failure is still in errno.
@@ -42,6 +131,7 @@ int check_standard_output(const std::string& program, int rc) {
 }
 
 int run_tool(const std::string& program, const std::function<int()>& body) {
+  end_startup_guard();
   // A file-size limit (ulimit -f) makes a write fail with EFBIG, reported like any failed write,
   // instead of killing the process with SIGXFSZ.
   std::signal(SIGXFSZ, SIG_IGN);
@@ -54,7 +144,11 @@ int run_tool(const std::string& program, const std::function<int()>& body) {
     std::cerr << program << ": error: out of memory\n";
     return kExitRuntime;
   } catch (const std::exception& e) {
-    std::cerr << program << ": error: " << e.what() << "\n";
+    if (is_out_of_memory(e)) {
+      std::cerr << program << ": error: out of memory: cannot start a thread (" << e.what() << ")\n";
+    } else {
+      std::cerr << program << ": error: " << e.what() << "\n";
+    }
     return kExitRuntime;
   } catch (...) {
     std::cerr << program << ": error: unknown failure\n";

@@ -23,7 +23,10 @@
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/data_path.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/stderr_capture.h"
 #include "prizma/spectral/tool_main.h"
+
+PRIZMA_TOOL_STARTUP_GUARD("prizma-relight");
 
 namespace {
 
@@ -101,6 +104,21 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
   return s;
 }
 
+// session.save(), with what libpng prints on stderr (e.g. "libpng error: No IDATs written into
+// file" when memory runs out) made part of the one error line, and running out of memory named.
+void save_one_line(relight::RelightSession& session, const std::string& output) {
+  spectral::StderrCapture capture;
+  try {
+    spectral::allocating("writing " + output, [&] { session.save(output); });
+  } catch (const InputError& e) {
+    throw InputError(e.input(), e.reason() + spectral::library_said("libpng", capture.finish(), e.what()));
+  } catch (const spectral::RuntimeError& e) {
+    throw spectral::RuntimeError(std::string(e.what()) + spectral::library_said("libpng", capture.finish(), e.what()));
+  }
+  const std::string printed = capture.finish();
+  if (!printed.empty()) std::cerr << printed << "\n";  // warnings of a successful write
+}
+
 int run(const CliOptions& o) {
   if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show && !o.serve) {
     throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i, --show or --serve");
@@ -112,7 +130,8 @@ int run(const CliOptions& o) {
   if (!o.output.empty()) relight::check_output_path(o.output, "--output");
   if (!o.preview.empty()) relight::check_output_path(o.preview, "--preview");
 
-  relight::RelightSession session(o.input);
+  relight::RelightSession session =
+      spectral::allocating("reading " + o.input, [&] { return relight::RelightSession(o.input); });
   const relight::RelightSettings cli_settings = settings_from(o, session);
   session.apply(cli_settings);
   if (!o.output.empty()) {
@@ -150,8 +169,8 @@ int run(const CliOptions& o) {
     session.apply(cli_settings);
   }
   if (!o.output.empty()) {
-    const double ms = session.relight();
-    session.save(o.output);
+    const double ms = spectral::allocating("relighting", [&] { return session.relight(); });
+    save_one_line(session, o.output);
     if (o.verbose) std::cerr << "prizma-relight: wrote " << o.output << " (relit in " << ms << " ms)\n";
   }
   if (o.show && !o.interactive) {

@@ -5,11 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <set>
 
 #include "prizma/relight/relight_image.h"
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
 
 namespace prizma::relight {
 
@@ -64,6 +66,10 @@ void apply_keys(const json& obj, const std::string& where, const RelightSession&
       } else if (key == "colourSpace") {
         s.output.display.colour_space = value.get<std::string>();
       } else if (key == "bitDepth") {
+        // Exactly the integers 8 and 16: nlohmann would truncate 8.7 and wrap 4294967304 to 8.
+        if (!value.is_number_integer() || (value != 8 && value != 16)) {
+          throw InputError(input, "must be 8 or 16 (got " + value.dump() + ")");
+        }
         s.output.bit_depth = value.get<int>();
       }
     } catch (const json::exception&) {
@@ -77,11 +83,14 @@ void apply_keys(const json& obj, const std::string& where, const RelightSession&
 std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSession& session,
                                          const RelightSettings& base) {
   const std::string name = path.string();
-  std::ifstream in(path);
+  spectral::require_regular_file(path, "a batch file");
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(name, "cannot open batch file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  spectral::check_json_depth(text, name);
   json doc;
   try {
-    doc = json::parse(in);
+    doc = json::parse(text);
   } catch (const json::exception& e) {
     throw InputError(name, std::string("not valid JSON: ") + e.what());
   }

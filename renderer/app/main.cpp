@@ -23,6 +23,8 @@
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/tool_main.h"
 
+PRIZMA_TOOL_STARTUP_GUARD("prizma-render");
+
 namespace {
 
 using prizma::spectral::InputError;
@@ -59,10 +61,11 @@ struct Options {
   std::string scene;
   std::string output;
   std::optional<std::int64_t> spp;
-  std::string spp_text;  // parsed by parse_sample_count: CLI11 wraps values beyond int64
   std::optional<int> width, height;
   std::string bins;
   std::optional<std::uint64_t> seed;
+  // As typed: checked by the scene loader against exactly the scene field's range.
+  std::optional<std::string> spp_text, width_text, height_text, seed_text;
   std::string samples;
   int threads = 0;
   std::string wavelength_sampling;
@@ -190,10 +193,10 @@ int main(int argc, char** argv) {
   app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own");
   app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")");
   app.add_option("--spp", o.spp_text, "samples per pixel (renders samples [begin, begin + N); with --resume the total)");
-  app.add_option("--width", o.width, "image width in pixels")->check(CLI::PositiveNumber);
-  app.add_option("--height", o.height, "image height in pixels")->check(CLI::PositiveNumber);
+  app.add_option("--width", o.width_text, "image width in pixels");
+  app.add_option("--height", o.height_text, "image height in pixels");
   app.add_option("--bins", o.bins, "bin layout: linear:400:700:12, exp:400:700:12:1.5, edges:400,450,500");
-  app.add_option("--seed", o.seed, "random seed");
+  app.add_option("--seed", o.seed_text, "random seed");
   app.add_option("--samples", o.samples, "sample range A:B of every pixel (for shards; merge them later)");
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_option("--wavelength-sampling", o.wavelength_sampling,
@@ -214,7 +217,10 @@ int main(int argc, char** argv) {
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   return spectral::run_tool(kProgram, [&] {
-    if (!o.spp_text.empty()) o.spp = render::parse_sample_count(o.spp_text, "--spp");
+    if (o.spp_text) o.spp = render::scene_integer_override(*o.spp_text, "samples", "--spp");
+    if (o.width_text) o.width = static_cast<int>(render::scene_integer_override(*o.width_text, "camera.width", "--width"));
+    if (o.height_text) o.height = static_cast<int>(render::scene_integer_override(*o.height_text, "camera.height", "--height"));
+    if (o.seed_text) o.seed = render::scene_seed_override(*o.seed_text, "--seed");
     render::RenderOverrides given;
     given.width = o.width;
     given.height = o.height;
@@ -255,7 +261,7 @@ int main(int argc, char** argv) {
       previous = std::move(plan.previous);
     } else {
       if (o.scene.empty()) throw InputError("scene", "no scene file given (or --resume a partial render)");
-      scene = render::load_scene(o.scene);
+      scene = spectral::allocating("reading the scene and its volume", [&] { return render::load_scene(o.scene); });
       render::apply_overrides(scene, given);
       auto& st = scene.settings;
       if (given.samples) std::tie(st.sample_begin, st.sample_end) = std::pair(given.samples->begin, given.samples->end);
@@ -294,7 +300,11 @@ int main(int argc, char** argv) {
     render::RenderStats stats;
     spectral::SpectralImage image;
     try {
-      image = render::render(scene, cb, &stats);
+      image = spectral::allocating(
+          "rendering (" + std::to_string(scene.camera.width) + "×" + std::to_string(scene.camera.height) +
+              " pixels × " + std::to_string(scene.lights.size()) + " lights × " + std::to_string(st.bins.size()) +
+              " bins)",
+          [&] { return render::render(scene, cb, &stats); });
     } catch (const spectral::RuntimeError& e) {
       if (g_signal.load() == 0) throw;
       bar.finish();

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "prizma/render/phase.h"
 #include "prizma/spectral/error.h"
@@ -13,6 +15,12 @@ constexpr double kPi = 3.14159265358979323846;
 // Ratio tracking's Russian roulette: below this largest transmittance, stop with probability kRrStop.
 constexpr float kTransmittanceRrThreshold = 0.05f;
 constexpr float kTransmittanceRrStop = 0.75f;
+// Tracking steps (collisions + shadow steps) one path may take. The scene loader bounds the
+// extinction so that a crossing takes at most ~2·10^6 steps; a path beyond this bound (albedo 1
+// in a very dense medium) is abandoned as NaN, which the render counts and reports, so every path
+// ends in bounded time.
+constexpr std::int64_t kMaxPathSteps = std::int64_t{1} << 28;
+constexpr float kAbandoned = std::numeric_limits<float>::quiet_NaN();
 
 // Lanes known at compile time (1) or not (0 = scratch.lanes).
 template <int kLanes>
@@ -215,6 +223,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
   if (!intersect_box(ray, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) return;
   MajorantTraversal walk(m_grid, ray, t_enter, t_exit);
   MajorantTraversal::Segment seg;
+  const std::int64_t step_limit = s.counters.shadow_steps + kMaxPathSteps;
   while (walk.next(seg)) {
     ++s.counters.majorant_cells;
     if (seg.majorant <= 0.0f) continue;
@@ -223,7 +232,10 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
     for (;;) {
       t -= std::log(rng.uniform()) * inv_mu;
       if (t >= seg.t1) break;
-      ++s.counters.shadow_steps;
+      if (++s.counters.shadow_steps > step_limit) {
+        for (int i = 0; i < n; ++i) T[i] = kAbandoned;
+        return;
+      }
       std::uint16_t m;
       float d;
       lookup(origin + t * dir, m, d);
@@ -279,6 +291,10 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   }
   ++s.counters.paths_in_volume;
   int bounces = 0;
+  const std::int64_t step_limit = s.counters.collisions + s.counters.shadow_steps + kMaxPathSteps;
+  auto abandon = [&] {
+    for (int i = 0; i < n; ++i) env[i] = kAbandoned;
+  };
   for (;;) {
     // Free flight: delta tracking with spectral tracking's event probabilities (Kutz et al. 2017,
     // "max" history-aware scheme): P_e ∝ max_i |w_i σ_e,i| for e ∈ {absorb, scatter, null}, and
@@ -297,7 +313,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
       for (;;) {
         t -= std::log(rng.uniform()) * inv_mu;
         if (t >= seg.t1) break;
-        ++s.counters.collisions;
+        if (++s.counters.collisions + s.counters.shadow_steps > step_limit) return abandon();
         const Eigen::Vector3d p = pos + t * dir;
         std::uint16_t m;
         float d;

@@ -8,6 +8,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -119,6 +120,14 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   if (per_pass <= 0) per_pass = std::max<std::int64_t>(1, kPathsPerPass / static_cast<std::int64_t>(pixels));
   per_pass = std::min(per_pass, total);
 
+  // Cancellation is polled at every sample: a pass cut short is abandoned (the accumulators go
+  // back to their state before it), so the image still holds whole passes only.
+  std::atomic<bool> pass_cut{false};
+  auto cancelled = [&] {
+    if (callbacks.cancel == nullptr || !callbacks.cancel->load(std::memory_order_relaxed)) return false;
+    pass_cut.store(true, std::memory_order_relaxed);
+    return true;
+  };
   auto render_pixel = [&](ThreadState& ts, int x, int y, std::int64_t s0, std::int64_t s1) {
     const std::size_t pix = static_cast<std::size_t>(y) * width + x;
     if (converged[pix]) return;
@@ -127,6 +136,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
     PathScratch& ps = ts.path;
     double* v = ts.value.data();
     for (std::int64_t s = s0; s < s1; ++s) {
+      if (cancelled()) return;
       Rng rng(st.seed, pix, static_cast<std::uint64_t>(s));
       const double px = x + rng.uniform_double();
       const double py = y + rng.uniform_double();
@@ -208,13 +218,19 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   auto run_pass = [&](std::int64_t s0, std::int64_t s1) {
     tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
       ThreadState& ts = states.local();
-      for (int y = rows.begin(); y != rows.end(); ++y)
+      for (int y = rows.begin(); y != rows.end() && !pass_cut.load(std::memory_order_relaxed); ++y)
         for (int x = 0; x < width; ++x) render_pixel(ts, x, y, s0, s1);
     });
   };
 
   std::int64_t done = 0;
   bool interrupted = false;
+  // The accumulators before the current pass, kept only when the render can be cancelled.
+  struct Snapshot {
+    std::vector<double> sum, sum_sq, total_sum, total_sq;
+    std::vector<std::int64_t> count;
+    std::vector<char> converged;
+  } before;
   while (done < total) {
     if (callbacks.cancel && callbacks.cancel->load()) {
       interrupted = true;
@@ -222,10 +238,28 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
     }
     const std::int64_t s0 = st.sample_begin + done;
     const std::int64_t s1 = std::min(st.sample_end, s0 + per_pass);
+    if (callbacks.cancel) {
+      before.sum.assign(sum.begin(), sum.end());
+      before.sum_sq.assign(sum_sq.begin(), sum_sq.end());
+      before.total_sum.assign(total_sum.begin(), total_sum.end());
+      before.total_sq.assign(total_sq.begin(), total_sq.end());
+      before.count.assign(count.begin(), count.end());
+      before.converged.assign(converged.begin(), converged.end());
+    }
     if (arena)
       arena->execute([&] { run_pass(s0, s1); });
     else
       run_pass(s0, s1);
+    if (pass_cut.load()) {
+      sum.swap(before.sum);
+      sum_sq.swap(before.sum_sq);
+      total_sum.swap(before.total_sum);
+      total_sq.swap(before.total_sq);
+      count.swap(before.count);
+      converged.swap(before.converged);
+      interrupted = true;
+      break;
+    }
     done = s1 - st.sample_begin;
     if (callbacks.progress) {
       RenderProgress p;

@@ -8,12 +8,15 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <utility>
 
 #include "prizma/render/scene.h"
 #include "prizma/render/transfer_function.h"
 #include "prizma/render/volume.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectral_exr.h"
+#include "prizma/spectral/input_file.h"
 #include "prizma/spectral/spectrum_spec.h"
 
 namespace prizma::render {
@@ -27,6 +30,13 @@ namespace {
 constexpr int kDefaultResolution = 128;
 constexpr int kMaxImageSide = 16384;
 constexpr std::size_t kMaxLightNameLength = 64;
+constexpr std::int64_t kMaxSamples = std::int64_t{1} << 40;
+// Densities are stored as float; extinction × density is what the trackers step through: one step
+// per unit of optical depth, so a path crosses the volume (largest side 1, diagonal ≤ √3) in at
+// most about kMaxExtinctionPerUnit · √3 steps. Beyond this a render would not end.
+constexpr std::int64_t kMaxBounces = 1000000;
+constexpr double kMaxDensity = 1e30;
+constexpr double kMaxExtinctionPerUnit = 1e6;
 
 std::string num(double v) {
   std::ostringstream s;
@@ -42,7 +52,10 @@ class Reader {
 
   const std::string& file() const { return m_file; }
   const std::filesystem::path& base_dir() const { return m_base; }
-  std::string input(const std::string& path) const { return path.empty() ? m_file : m_file + ": " + path; }
+  std::string input(const std::string& path) const {
+    if (m_file.empty()) return path;  // a command-line option
+    return path.empty() ? m_file : m_file + ": " + path;
+  }
 
   [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
     throw InputError(input(path), reason);
@@ -335,6 +348,7 @@ TransferFunction read_materials(const Reader& rd, const json& j, const ValueNorm
       if (d.is_number()) {
         const double v = rd.number(d, dp);
         if (v < 0.0) rd.fail(dp, "must be ≥ 0 (got " + num(v) + ")");
+        if (v > kMaxDensity) rd.fail(dp, "must be at most " + num(kMaxDensity) + " (got " + num(v) + ")");
         rule.density.values = {0.0};
         rule.density.densities = {v};
       } else {
@@ -347,6 +361,9 @@ TransferFunction read_materials(const Reader& rd, const json& j, const ValueNorm
           double v = rd.number(d[k][0], Reader::index(pp, 0));
           const double dens = rd.number(d[k][1], Reader::index(pp, 1));
           if (dens < 0.0) rd.fail(Reader::index(pp, 1), "must be ≥ 0 (got " + num(dens) + ")");
+          if (dens > kMaxDensity) {
+            rd.fail(Reader::index(pp, 1), "must be at most " + num(kMaxDensity) + " (got " + num(dens) + ")");
+          }
           if (normalised) v = norm.from_unit(v);
           if (!rule.density.values.empty() && !(v > rule.density.values.back())) {
             rd.fail(Reader::index(pp, 0), "values must be strictly increasing (got " + d[k][0].dump() + " after " +
@@ -472,7 +489,12 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
     if (!lj.contains("direction")) rd.fail(dp, "is required ([0, 0, 0] = uniform environment)");
     const auto d = rd.vec3(lj.at("direction"), dp);
     l.direction = Eigen::Vector3d(d[0], d[1], d[2]);
-    if (l.direction.norm() > 0.0) l.direction.normalize();
+    // Only the exact zero vector is the environment: scale by the largest component first, so
+    // that a length of 1e-200 (norm underflows to 0) or 1e200 (overflows) keeps its direction.
+    if (const double largest = l.direction.cwiseAbs().maxCoeff(); largest > 0.0) {
+      l.direction /= largest;
+      l.direction.normalize();
+    }
     if (lj.contains("angular_size_deg")) {
       const std::string ap = Reader::join(lp, "angular_size_deg");
       l.angular_size_deg = rd.number(lj.at("angular_size_deg"), ap);
@@ -494,20 +516,21 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
   return lights;
 }
 
+std::uint64_t read_seed(const Reader& rd, const json& j, const std::string& path) {
+  if (!j.is_number_integer() || (!j.is_number_unsigned() && j.get<std::int64_t>() < 0)) {
+    rd.fail(path, "must be an integer ≥ 0 (got " + Reader::describe(j) + ")");
+  }
+  return j.get<std::uint64_t>();
+}
+
 void read_settings(const Reader& rd, const json& root, RenderSettings& s) {
   if (root.contains("bins")) {
     s.bins = spectral::BinLayout::parse(rd.string(root.at("bins"), "bins"), rd.input("bins"));
     spectral::check_exr_bin_names(s.bins, rd.input("bins"));
   }
-  if (root.contains("samples")) s.sample_end = rd.integer(root.at("samples"), "samples", 1, std::int64_t{1} << 40);
-  if (root.contains("seed")) {
-    const json& j = root.at("seed");
-    if (!j.is_number_integer() || (!j.is_number_unsigned() && j.get<std::int64_t>() < 0)) {
-      rd.fail("seed", "must be an integer ≥ 0 (got " + Reader::describe(j) + ")");
-    }
-    s.seed = j.get<std::uint64_t>();
-  }
-  if (root.contains("max_bounces")) s.max_bounces = static_cast<int>(rd.integer(root.at("max_bounces"), "max_bounces", -1, 1000000));
+  if (root.contains("samples")) s.sample_end = rd.integer(root.at("samples"), "samples", 1, kMaxSamples);
+  if (root.contains("seed")) s.seed = read_seed(rd, root.at("seed"), "seed");
+  if (root.contains("max_bounces")) s.max_bounces = static_cast<int>(rd.integer(root.at("max_bounces"), "max_bounces", -1, kMaxBounces));
   if (root.contains("wavelength_sampling")) {
     const std::string w = rd.string(root.at("wavelength_sampling"), "wavelength_sampling");
     if (w == "spectral-tracking") s.wavelength_sampling = WavelengthSampling::SpectralTracking;
@@ -517,6 +540,27 @@ void read_settings(const Reader& rd, const json& root, RenderSettings& s) {
   if (root.contains("target_error")) {
     s.target_error = rd.number(root.at("target_error"), "target_error");
     if (s.target_error < 0.0) rd.fail("target_error", "must be ≥ 0 (got " + num(s.target_error) + ")");
+  }
+}
+
+// Refuses a medium whose largest extinction × density the trackers cannot step through (float
+// overflow makes a majorant infinite and a step zero; a huge optical depth never ends), naming the
+// material's extinction (or the transfer function's extinction_scale).
+void check_trackable(const Reader& rd, const Medium& med, bool has_materials) {
+  std::vector<float> max_density(med.materials.size(), 0.0f);
+  for (std::size_t v = 0; v < med.material.size(); ++v) {
+    const std::uint16_t m = med.material[v];
+    if (m != Medium::kEmpty && m < max_density.size()) max_density[m] = std::max(max_density[m], med.density[v]);
+  }
+  for (std::size_t m = 0; m < med.materials.size(); ++m) {
+    if (!(max_density[m] > 0.0f)) continue;
+    const double mu = med.materials[m].sigma_t_per_unit.max_value() * static_cast<double>(max_density[m]);
+    if (mu <= kMaxExtinctionPerUnit) continue;
+    const std::string field = has_materials ? Reader::join(Reader::index("materials", m), "extinction")
+                                            : "transfer_function.extinction_scale";
+    rd.fail(field, "extinction × density reaches " + num(mu) + " per unit length (material \"" +
+                       med.materials[m].name + "\"); the tracker steps through at most " +
+                       num(kMaxExtinctionPerUnit) + " per unit length (the volume's largest side is 1 unit)");
   }
 }
 
@@ -547,6 +591,8 @@ json parse_json(const std::string& text, const std::string& file) {
     }
     return true;
   };
+  // Depth first: nlohmann::json recurses to print, compare and copy values.
+  spectral::check_json_depth(text, file);
   try {
     json j = json::parse(text, cb);
     if (!duplicate.empty()) throw InputError(file, "duplicate key \"" + duplicate + "\"");
@@ -568,12 +614,38 @@ json parse_json(const std::string& text, const std::string& file) {
   }
 }
 
+// The integer range of a scene field, shared by the scene reader and the command-line overrides.
+std::pair<std::int64_t, std::int64_t> integer_field_range(const std::string& field) {
+  if (field == "camera.width" || field == "camera.height") return {1, kMaxImageSide};
+  if (field == "samples") return {1, kMaxSamples};
+  if (field == "max_bounces") return {-1, kMaxBounces};
+  throw std::logic_error("integer_field_range: unknown field " + field);
+}
+
+// A command-line value as JSON (so that "1e9", "8.7" and "-1" are what they are), or InputError.
+json override_json(const std::string& text, const std::string& option, const char* expected) {
+  spectral::check_json_depth(text, option);
+  json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) throw InputError(option, std::string("must be ") + expected + " (got \"" + text + "\")");
+  return j;
+}
+
 }  // namespace
+
+std::int64_t scene_integer_override(const std::string& text, const std::string& field, const std::string& option) {
+  const auto [lo, hi] = integer_field_range(field);
+  const json j = override_json(text, option, "an integer");
+  return Reader("", {}).integer(j, option, lo, hi);
+}
+
+std::uint64_t scene_seed_override(const std::string& text, const std::string& option) {
+  const json j = override_json(text, option, "an integer ≥ 0");
+  return read_seed(Reader("", {}), j, option);
+}
 
 Scene load_scene(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(file, "no such scene file");
+  spectral::require_regular_file(path, "a scene file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(file, "cannot open scene file");
   std::stringstream buffer;
@@ -612,6 +684,7 @@ Scene load_scene(const std::filesystem::path& path) {
   const TransferFunction tf = has_materials ? read_materials(rd, root.at("materials"), norm)
                                             : read_tf_image(rd, root.at("transfer_function"), norm);
   scene.medium = build_medium(vol, tf, rd.input("volume"), interpolation);
+  check_trackable(rd, scene.medium, has_materials);
 
   // Emission: one light layer for every emitting material, only when some material emits (a scene
   // without emission renders exactly as before).

@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
+#include "prizma/spectral/stderr_capture.h"
 
 namespace prizma::render {
 
@@ -34,6 +36,25 @@ void spectrum_extremes(const Spectrum& s, double& lo, double& hi) {
 }
 
 constexpr double kMaxAbsG = 0.999;
+// Transfer-function images: at most this many pixels (a row per value level, a column per
+// wavelength sample; 2048 × 2048 is far more than any real one), and at most this many decoded
+// bytes per byte of file (deflate's limit is 1032:1, LZW's about 2000:1), so a tiny file that
+// claims a huge image is refused before anything is allocated.
+constexpr long long kMaxTfPixels = 1LL << 22;
+constexpr long long kMaxTfExpansion = 4096;
+
+// The last error OpenImageIO holds (global, then the reader's), on one line; clearing both, so
+// that nothing is left for OpenImageIO to print at exit.
+std::string oiio_error(OIIO::ImageInput* in) {
+  std::string e = in != nullptr ? in->geterror() : std::string();
+  const std::string global = OIIO::geterror();
+  if (e.empty()) e = global;
+  for (char& c : e) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!e.empty() && e.back() == ' ') e.pop_back();
+  return e.empty() ? "unknown error" : e;
+}
 
 }  // namespace
 
@@ -104,18 +125,45 @@ TransferFunction read_transfer_function_image(const std::filesystem::path& image
                                 num(lambda_hi_nm) + "])");
   }
   const std::string file = image.string();
+  try {
+    spectral::require_regular_file(image, "a transfer-function image");
+  } catch (const InputError& e) {
+    throw InputError(input, std::string("image ") + e.what());
+  }
+  std::error_code ec;
+  const auto file_bytes = static_cast<long long>(std::filesystem::file_size(image, ec));
+  // libpng prints its errors on stderr before OpenImageIO reports them: captured into the one line.
+  spectral::StderrCapture open_capture;
   auto in = OIIO::ImageInput::open(file);
-  if (!in) throw InputError(input, "cannot read image " + file + ": " + OIIO::geterror());
+  const std::string open_printed = open_capture.finish();
+  if (!in) {
+    const std::string e = oiio_error(nullptr);
+    throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("libpng", open_printed, e));
+  }
   const OIIO::ImageSpec spec = in->spec();
   const int w = spec.width;
   const int h = spec.height;
   const int nc = spec.nchannels;
   if (w < 1 || h < 1) throw InputError(input, "image " + file + " is empty");
   if (nc < 3) throw InputError(input, "image " + file + " has " + std::to_string(nc) + " channel(s); needs R, G, B");
-  if (static_cast<long long>(w) * h > (1LL << 26)) throw InputError(input, "image " + file + " is too large");
-  std::vector<float> px(static_cast<std::size_t>(w) * h * nc);
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, px.data())) {
-    throw InputError(input, "cannot read image " + file + ": " + in->geterror());
+  const long long pixels = static_cast<long long>(w) * h;
+  if (pixels > kMaxTfPixels) {
+    throw InputError(input, "image " + file + " is " + std::to_string(w) + "×" + std::to_string(h) +
+                                " pixels; a transfer function has at most " + std::to_string(kMaxTfPixels) + " pixels");
+  }
+  const long long decoded = pixels * nc * static_cast<long long>(spec.format.size());
+  if (ec || decoded > kMaxTfExpansion * std::max(file_bytes, 1LL)) {
+    throw InputError(input, "image " + file + " claims " + std::to_string(w) + "×" + std::to_string(h) + "×" +
+                                std::to_string(nc) + " pixels, more than its " + std::to_string(file_bytes) +
+                                " bytes can hold (truncated or corrupt)");
+  }
+  std::vector<float> px(static_cast<std::size_t>(pixels) * nc);
+  spectral::StderrCapture read_capture;
+  const bool read_ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, px.data());
+  const std::string read_printed = read_capture.finish();
+  if (!read_ok) {
+    const std::string e = oiio_error(in.get());
+    throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("libpng", read_printed, e));
   }
   in->close();
 

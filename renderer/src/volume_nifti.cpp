@@ -1,15 +1,20 @@
 // NIfTI-1 volumes (.nii, .nii.gz) through libnifti. The header is read and checked first (type,
 // dimensions, memory), then the voxels; every libnifti return is checked.
 #include <nifti1_io.h>
-#include <znzlib.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
+#include <string>
 
 #include "prizma/render/volume.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
+#include "prizma/spectral/stderr_capture.h"
 #include "volume_budget.h"
 
 namespace prizma::render {
@@ -33,6 +38,41 @@ void convert(const void* data, std::size_t n, double slope, double inter, std::v
   }
 }
 
+// " (libnifti: <what it printed>)", or "".
+std::string library_said(const std::string& printed) {
+  return printed.empty() ? std::string() : " (libnifti: " + printed + ")";
+}
+
+// The header exactly as stored: libnifti's nifti_image turns a pixdim of 0 into 1 and a negative
+// vox_offset into 348, so the checks the format requires are made here.
+void check_raw_header(const std::string& input) {
+  int swapped = 0;
+  spectral::StderrCapture capture;
+  nifti_1_header* h = nifti_read_header(input.c_str(), &swapped, 1);
+  const std::string printed = capture.finish();
+  if (h == nullptr) {
+    throw InputError(input, "not a readable NIfTI-1 file (corrupt, truncated or another format)" + library_said(printed));
+  }
+  const nifti_1_header hdr = *h;
+  std::free(h);
+  const int ndim = std::clamp<int>(hdr.dim[0], 0, 7);
+  for (int a = 1; a <= std::min(ndim, 3); ++a) {
+    const float p = hdr.pixdim[a];
+    if (hdr.dim[a] > 1 && !(std::isfinite(p) && p != 0.0f)) {
+      throw InputError(input, "pixdim[" + std::to_string(a) + "] must be a finite non-zero voxel size on an axis of " +
+                                  std::to_string(hdr.dim[a]) + " voxels (got " + std::to_string(p) + ")");
+    }
+  }
+  const bool one_file = std::string(hdr.magic, 3) == "n+1";
+  const float off = hdr.vox_offset;
+  const float min_off = one_file ? 352.0f : 0.0f;
+  if (!(std::isfinite(off) && off >= min_off && off == std::floor(off))) {
+    throw InputError(input, "vox_offset " + std::to_string(off) + " is invalid (a " +
+                                (one_file ? std::string("single-file .nii needs a whole number ≥ 352")
+                                          : std::string(".hdr/.img pair needs a whole number ≥ 0")) + ")");
+  }
+}
+
 std::string datatype_name(int dt) {
   const char* s = nifti_datatype_to_string(dt);
   return s != nullptr ? std::string(s) : "datatype " + std::to_string(dt);
@@ -42,13 +82,17 @@ std::string datatype_name(int dt) {
 
 Volume load_nifti_volume(const std::filesystem::path& path) {
   const std::string input = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(input, "no such file");
+  spectral::require_regular_file(path, "a NIfTI file");
 
   // libnifti reports failures on stderr at debug level ≥ 1; we report them ourselves.
   nifti_set_debug_level(0);
+  check_raw_header(input);
+  spectral::StderrCapture capture;
   NiftiPtr nim(nifti_image_read(input.c_str(), 0));
-  if (!nim) throw InputError(input, "not a readable NIfTI-1 file (corrupt, truncated or another format)");
+  const std::string printed = capture.finish();
+  if (!nim) {
+    throw InputError(input, "not a readable NIfTI-1 file (corrupt, truncated or another format)" + library_said(printed));
+  }
 
   // Supported voxel types only.
   const int dt = nim->datatype;
@@ -104,20 +148,37 @@ Volume load_nifti_volume(const std::filesystem::path& path) {
   constexpr std::size_t kChunkBytes = std::size_t{64} << 20;
   std::vector<unsigned char> raw;
   {
-    znzFile fp = znzopen(nim->iname, "rb", nifti_is_gzfile(nim->iname));
-    if (znz_isnull(fp)) throw InputError(input, "cannot open the voxel data " + std::string(nim->iname));
+    // zlib directly (it reads plain files too), so that a .gz stream cut before its trailer (the
+    // CRC and length that prove the data complete) is refused, not taken as read.
+    const bool gz = nifti_is_gzfile(nim->iname) != 0;
+    gzFile fp = gzopen(nim->iname, "rb");
+    if (fp == nullptr) throw InputError(input, "cannot open the voxel data " + std::string(nim->iname));
     std::size_t got = 0;
-    if (znzseek(fp, nim->iname_offset, SEEK_SET) >= 0) {
+    if (gzseek(fp, static_cast<z_off_t>(nim->iname_offset), SEEK_SET) >= 0) {
       while (got < nbytes) {
         const std::size_t want = std::min(kChunkBytes, nbytes - got);
         if (raw.capacity() < got + want) raw.reserve(std::min(nbytes, std::max(got + want, 2 * raw.capacity())));
         raw.resize(got + want);
-        const std::size_t n = znzread(raw.data() + got, 1, want, fp);
-        got += n;
-        if (n != want) break;
+        const int n = gzread(fp, raw.data() + got, static_cast<unsigned>(want));
+        if (n > 0) got += static_cast<std::size_t>(n);
+        if (n != static_cast<int>(want)) break;
       }
     }
-    znzclose(fp);
+    bool stream_ok = true;
+    if (gz && got == nbytes) {
+      // Read on to the end of the stream: zlib checks the trailer there.
+      unsigned char rest[4096];
+      int n = 0;
+      while ((n = gzread(fp, rest, sizeof rest)) > 0) {
+      }
+      int err = Z_OK;
+      gzerror(fp, &err);
+      stream_ok = n == 0 && (err == Z_OK || err == Z_STREAM_END);
+    }
+    gzclose(fp);
+    if (!stream_ok) {
+      throw InputError(input, "the gzip stream is incomplete or damaged (no valid gzip trailer after the voxels)");
+    }
     if (got != nbytes) {
       throw InputError(input, "cannot read the voxel data: file corrupt or truncated (needs " + std::to_string(nbytes) +
                                   " bytes at offset " + std::to_string(nim->iname_offset) + ")");

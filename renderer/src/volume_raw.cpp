@@ -14,6 +14,7 @@
 
 #include "prizma/render/volume.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
 #include "volume_budget.h"
 
 namespace prizma::render {
@@ -100,6 +101,7 @@ T load_element(const unsigned char* p, bool swap) {
 
 Volume load_raw_volume(const RawVolumeSpec& spec) {
   const std::string input = spec.path.string();
+  spectral::require_regular_file(spec.path, "a raw volume file");
   std::array<int, 3> dims = spec.dims;
   VoxelType type = spec.type;
 

@@ -68,6 +68,34 @@ if(TARGET prizma-render)
   prizma_render_error(spectrum_unsorted spectrum_unsorted.json "unsorted\\.csv" "increasing|sorted|order")
   prizma_render_error(spectrum_nan spectrum_nan.json "nan\\.csv" "nan|NaN|finite|number")
   prizma_render_error(spectrum_negative spectrum_negative.json "spectrum_negative\\.json.*albedo|negative\\.csv" "-0\\.2|negative|\\[0, 1\\]")
+  # Inputs that are not regular files (they blocked forever), deep JSON (crashed), and what a
+  # scene path really is (issue 11).
+  prizma_render_error(scene_fifo scene_fifo.json "scene_fifo\\.json" "FIFO")
+  prizma_render_error(scene_dir scene_dir.json "scene_dir\\.json" "is a folder")
+  prizma_render_error(scene_loop scene_loop_a.json "scene_loop_a\\.json" "symbolic link loop")
+  prizma_render_error(scene_deep scene_deep.json "scene_deep\\.json" "nested deeper than 128 levels")
+  prizma_render_error(spectrum_fifo spectrum_fifo.json "fifo\\.csv" "FIFO")
+  prizma_render_error(raw_fifo raw_fifo.json "fifo_4x4x4_uint8\\.raw" "FIFO")
+  prizma_render_error(tf_dev_zero tf_dev_zero.json "transfer_function\\.image" "/dev/zero: is a character device")
+  # Extinction beyond what the tracker steps through (the render never ended), a PNG claiming more
+  # pixels than it holds (1.2 GB before it was refused), a truncated PNG (four lines).
+  prizma_render_error(scene_extinction_huge scene_extinction_huge.json "materials\\[0\\]\\.extinction" "extinction × density reaches 1e\\+39")
+  prizma_render_error(scene_density_huge scene_density_huge.json "materials\\[0\\]\\.extinction" "reaches 5000000 per unit length")
+  prizma_render_error(tf_huge_png tf_huge_png.json "transfer_function\\.image" "8192×8192")
+  prizma_render_error(tf_truncated_png tf_truncated_png.json "transfer_function\\.image" "cannot read image")
+  # NIfTI headers the format refuses (they were read as pixdim 1, unchecked, shifted).
+  prizma_render_error(nifti_pixdim_zero nifti_pixdim_zero_nii.json "pixdim_zero\\.nii" "pixdim\\[2\\]")
+  prizma_render_error(nifti_vox_offset nifti_vox_offset_negative_nii.json "vox_offset_negative\\.nii" "vox_offset")
+  prizma_render_error(nifti_no_trailer nifti_no_trailer_nii_gz.json "no_trailer\\.nii\\.gz" "gzip")
+  # Command-line values obey exactly the scene's ranges.
+  prizma_error_e2e(render_cli_width prizma-render 2 "^(--width)" "must be in \\[1, 16384\\] \\(got 20000\\)" render_cli_width.exr
+                   good.json --width 20000 -o render_cli_width.exr)
+  prizma_error_e2e(render_cli_width_float prizma-render 2 "^(--width)" "must be an integer" render_cli_width_float.exr
+                   good.json --width 1e9 -o render_cli_width_float.exr)
+  prizma_error_e2e(render_cli_seed prizma-render 2 "^(--seed)" "must be an integer ≥ 0" render_cli_seed.exr
+                   good.json --seed -1 -o render_cli_seed.exr)
+  prizma_error_e2e(render_cli_spp prizma-render 2 "^(--spp)" "must be in \\[1, " render_cli_spp.exr
+                   good.json --spp 0 -o render_cli_spp.exr)
   # A spectrum outside the bins is zero there by definition (spectrum.h), so a material or a light's
   # default spectrum that misses the bins is valid for the renderer; prizma-relight refuses a light
   # with no energy inside the bins (below).
@@ -97,6 +125,12 @@ if(TARGET prizma-relight)
            WORKING_DIRECTORY ${_errors_work})
   set_tests_properties(errors.e2e.relight_unusable_light_overridden PROPERTIES FIXTURES_REQUIRED errors_files
                        LABELS errors ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+  prizma_relight_error(moved_edges moved_edges.exr "is not the centre 435 nm of its bin")
+  prizma_relight_error(fifo fifo.exr "FIFO")
+  prizma_error_e2e(relight_batch_bitdepth prizma-relight 2 "batch_bitdepth\\.json: outputs\\[0\\]\\.bitDepth" "must be 8 or 16 \\(got 8\\.7\\)"
+                   batch_bitdepth.png good.exr --batch batch_bitdepth.json)
+  prizma_error_e2e(relight_batch_deep prizma-relight 2 "batch_deep\\.json" "nested deeper than" batch_deep.png
+                   good.exr --batch batch_deep.json)
   prizma_relight_error(truncated_existing_output truncated.exr "." EXISTING)
   prizma_relight_error(not_an_exr_existing_exr not_an_exr.exr "EXR|OpenEXR" EXISTING)
   # Light spectra: outside the colour matching range, unsorted CSV.
@@ -108,4 +142,20 @@ if(TARGET prizma-relight)
                    good.exr --light csv:unsorted.csv -o relight_light_unsorted.png)
   prizma_error_e2e(relight_light_nan_csv prizma-relight 2 "nan\\.csv" "finite" relight_light_nan.png EXISTING
                    good.exr --light csv:nan.csv -o relight_light_nan.png)
+endif()
+
+# Out of memory wherever it happens (issue 11): under a series of address-space limits each run is
+# a success or exit 1 with one "out of memory" line (below ~400 MB the dynamic loader itself cannot
+# map Debian's OpenImageIO dependencies: exit 127 before any code runs, so the limits start there).
+# Not in sanitizer builds: ASan reserves terabytes of address space.
+if(NOT PRIZMA_SANITIZE AND NOT PRIZMA_FUZZ AND TARGET prizma-render AND TARGET prizma-relight)
+  set(_limits 400,420,440,450,460,480,500,550,600,800,1200,2000,4000)
+  add_test(NAME errors.e2e.render_out_of_memory
+           COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-memory-limits --workdir ${_errors_work}
+                   --output mem_render.exr --limits-mb ${_limits} -- $<TARGET_FILE:prizma-render> good.json -q -o mem_render.exr)
+  add_test(NAME errors.e2e.relight_out_of_memory
+           COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-memory-limits --workdir ${_errors_work}
+                   --output mem_relight.png --limits-mb ${_limits} -- $<TARGET_FILE:prizma-relight> good.exr -o mem_relight.png)
+  set_tests_properties(errors.e2e.render_out_of_memory errors.e2e.relight_out_of_memory PROPERTIES
+                       FIXTURES_REQUIRED errors_files LABELS errors ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
 endif()

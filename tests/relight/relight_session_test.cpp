@@ -245,6 +245,29 @@ TEST(BatchFile, BadEntryStopsTheBatchBeforeAnythingIsWritten) {
   EXPECT_THROW(read_batch_file(dir / "format.json", session, session.settings()), spectral::InputError);
 }
 
+// issue 11: a batch bitDepth of 8.7 or 4294967304 became 8; deeply nested JSON crashed.
+TEST(BatchFile, RefusesNonIntegerBitDepthsAndDeepJson) {
+  const fs::path dir = test::scratch_dir("batchdepth");
+  RelightSession session(write_fixture(dir));
+  auto error = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    try {
+      read_batch_file(dir / name, session, session.settings());
+    } catch (const spectral::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  for (const char* bad : {"8.7", "4294967304", "24", "\"8\"", "-8"}) {
+    const std::string msg = error("bits.json", std::string(R"({"outputs": [{"file": "a.png", "bitDepth": )") + bad + "}]}");
+    EXPECT_NE(msg.find("outputs[0].bitDepth: must be 8 or 16"), std::string::npos) << bad << ": " << msg;
+  }
+  EXPECT_EQ(error("ok.json", R"({"outputs": [{"file": "a.png", "bitDepth": 16}]})"), "no error");
+  const std::string deep = error("deep.json", R"({"outputs": [{"file": "a.png", "view": )" + std::string(70000, '[') +
+                                                  std::string(70000, ']') + "}]}");
+  EXPECT_NE(deep.find("nested deeper than"), std::string::npos) << deep;
+}
+
 TEST(OutputImage, RejectsUnwritableAndUnknownPaths) {
   const fs::path dir = test::scratch_dir("paths");
   EXPECT_THROW(check_output_path(dir / "missing" / "a.png"), spectral::InputError);

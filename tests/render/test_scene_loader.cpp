@@ -4,6 +4,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <sys/stat.h>
+
 #include <cstring>
 #include <nlohmann/json.hpp>
 
@@ -422,7 +424,7 @@ TEST(SceneLoaderErrors, VolumeAndTransferFunction) {
   j["transfer_function"] = {{"image", "tf.png"}, {"extinction_scale", -5}};
   expect_error(dir, j, "transfer_function.extinction_scale", "must be > 0 (got -5)");
   j["transfer_function"] = {{"image", "absent.png"}, {"extinction_scale", 5}};
-  expect_error(dir, j, "transfer_function.image", "cannot read image");
+  expect_error(dir, j, "transfer_function.image", "absent.png: no such file");
   j = base_scene();
   j["normalisation"] = {{"min", 5}, {"max", 5}};
   expect_error(dir, j, "normalisation.max", "must be > min");
@@ -436,6 +438,104 @@ TEST(SceneLoaderErrors, VolumeAndTransferFunction) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.input(), (dir / "absent_2x2x2_uint8.raw").string());
   }
+}
+
+// issue 11: deeply nested JSON crashed (SIGSEGV in nlohmann's recursive dump); now one InputError.
+TEST(SceneLoader, RefusesJsonNestedTooDeeply) {
+  ScratchDir dir;
+  const std::string deep = "{\"description\": " + std::string(70000, '[') + std::string(70000, ']') + "}";
+  const InputError e = load_error(dir.write("deep.json", deep));
+  EXPECT_EQ(e.input(), (dir / "deep.json").string());
+  EXPECT_NE(e.reason().find("nested deeper than"), std::string::npos) << e.what();
+  EXPECT_NE(e.reason().find("line 1, column"), std::string::npos) << e.what();
+  // Brackets inside strings do not count.
+  json j = base_scene();
+  j["description"] = std::string(1000, '[');
+  EXPECT_NO_THROW(load_scene(write_scene(dir, j)));
+}
+
+// issue 11: a directory, a FIFO and a symlink loop all said "does not exist".
+TEST(SceneLoader, SaysWhatANonRegularSceneIs) {
+  ScratchDir dir;
+  std::filesystem::create_directory(dir / "folder.json");
+  EXPECT_NE(load_error(dir / "folder.json").reason().find("is a folder"), std::string::npos);
+  ASSERT_EQ(::mkfifo((dir / "pipe.json").c_str(), 0600), 0);
+  EXPECT_NE(load_error(dir / "pipe.json").reason().find("FIFO"), std::string::npos);  // and no hang
+  std::filesystem::create_symlink(dir / "loop_b.json", dir / "loop_a.json");
+  std::filesystem::create_symlink(dir / "loop_a.json", dir / "loop_b.json");
+  EXPECT_NE(load_error(dir / "loop_a.json").reason().find("symbolic link loop"), std::string::npos);
+  std::filesystem::create_symlink(dir / "nowhere.json", dir / "dangling.json");
+  EXPECT_NE(load_error(dir / "dangling.json").reason().find("does not exist"), std::string::npos);
+  EXPECT_NE(load_error(dir / "absent.json").reason().find("no such file"), std::string::npos);
+  EXPECT_NE(load_error("/dev/null").reason().find("character device"), std::string::npos);
+}
+
+// issue 11: a light direction of length 1e-200 (norm underflows) or 1e200 (overflows) became the
+// environment light; only the zero vector is the environment.
+TEST(SceneLoader, TinyAndHugeLightDirectionsStayDirections) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["lights"][0]["direction"] = {1e-200, 0, 0};
+  j["lights"][1]["direction"] = {0, -1e200, 1e200};
+  const Scene s = load_scene(write_scene(dir, j));
+  EXPECT_TRUE(s.lights[0].direction.isApprox(Eigen::Vector3d(1, 0, 0))) << s.lights[0].direction.transpose();
+  EXPECT_TRUE(s.lights[1].direction.isApprox(Eigen::Vector3d(0, -1, 1).normalized()))
+      << s.lights[1].direction.transpose();
+}
+
+// issue 11: an extinction (or extinction × density) beyond what the tracker can step through
+// passed validation and the render never ended.
+TEST(SceneLoader, RefusesExtinctionTheTrackerCannotRepresent) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["materials"][1]["extinction"] = 1e39;  // beyond float
+  expect_error(dir, j, "materials[1].extinction", "extinction × density reaches");
+  j = base_scene();
+  j["materials"][1]["extinction"] = 2e6;
+  expect_error(dir, j, "materials[1].extinction", "per unit length");
+  j = base_scene();
+  j["materials"][0]["extinction"] = 1000;
+  j["materials"][0]["density"] = 5000;  // 5e6 per unit
+  expect_error(dir, j, "materials[0].extinction", "extinction × density reaches");
+  j = base_scene();
+  j["materials"][1]["density"] = {{200, 0.5}, {255, 1e300}};
+  expect_error(dir, j, "materials[1].density[1][1]", "must be at most");
+  // The bound itself is fine, and an extinction outside any voxel's material costs nothing.
+  j = base_scene();
+  j["materials"][1]["extinction"] = 1e6;
+  EXPECT_NO_THROW(load_scene(write_scene(dir, j)));
+}
+
+// issue 11: command-line values obey exactly the scene's ranges (--width 20000 bypassed 16384,
+// --seed -1 wrapped, --width 1e9 exited 1).
+TEST(SceneLoader, CommandLineOverridesObeyTheSceneRanges) {
+  EXPECT_EQ(scene_integer_override("640", "camera.width", "--width"), 640);
+  EXPECT_EQ(scene_integer_override("16384", "camera.height", "--height"), 16384);
+  EXPECT_EQ(scene_integer_override("1099511627776", "samples", "--spp"), std::int64_t{1} << 40);
+  EXPECT_EQ(scene_seed_override("18446744073709551615", "--seed"), 18446744073709551615ULL);
+  auto error = [](auto f) {
+    try {
+      f();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error([] { scene_integer_override("20000", "camera.width", "--width"); }),
+            "--width: must be in [1, 16384] (got 20000)");
+  EXPECT_EQ(error([] { scene_integer_override("0", "camera.height", "--height"); }),
+            "--height: must be in [1, 16384] (got 0)");
+  EXPECT_NE(error([] { scene_integer_override("1e9", "camera.width", "--width"); }).find("--width: must be an integer"),
+            std::string::npos);
+  EXPECT_NE(error([] { scene_integer_override("8.7", "samples", "--spp"); }).find("--spp: must be an integer"),
+            std::string::npos);
+  EXPECT_NE(error([] { scene_integer_override("many", "samples", "--spp"); }).find("--spp: must be an integer"),
+            std::string::npos);
+  EXPECT_EQ(error([] { scene_integer_override("1099511627777", "samples", "--spp"); }),
+            "--spp: must be in [1, 1099511627776] (got 1099511627777)");
+  EXPECT_NE(error([] { scene_seed_override("-1", "--seed"); }).find("--seed: must be an integer ≥ 0"), std::string::npos);
+  EXPECT_NE(error([] { scene_seed_override("18446744073709551616", "--seed"); }).find("--seed: must be an integer"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -6,7 +6,12 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <sys/stat.h>
+#include <zlib.h>
+
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "prizma/spectral/error.h"
@@ -220,6 +225,69 @@ TEST(TransferFunctionImage, Errors) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.input(), "scene.json: transfer_function.image");
   }
+}
+
+// The message of the InputError that reading `path` as a transfer function throws.
+std::string tf_error(const std::filesystem::path& path) {
+  try {
+    read_transfer_function_image(path, 1.0, 400, 700, ValueNormalisation{}, "tf");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// issue 11: a 150-byte PNG whose header claims 8192×8192 cost 1.2 GB before it was refused.
+TEST(TransferFunctionImage, RefusesDimensionsTheFileCannotHold) {
+  ScratchDir dir;
+  write_png(dir / "small.png", 2, 2, std::vector<unsigned char>(12, 100));
+  std::ifstream in(dir / "small.png", std::ios::binary);
+  std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(png.size(), 33u);
+  ASSERT_EQ(png.substr(12, 4), "IHDR");
+  auto put_be32 = [&](std::size_t at, std::uint32_t v) {
+    for (int k = 0; k < 4; ++k) png[at + k] = static_cast<char>((v >> (24 - 8 * k)) & 0xff);
+  };
+  put_be32(16, 8192);  // width
+  put_be32(20, 8192);  // height
+  put_be32(29, static_cast<std::uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(png.data() + 12), 17)));
+  const std::string msg = tf_error(dir.write("huge.png", png));
+  EXPECT_NE(msg.find("8192×8192"), std::string::npos) << msg;  // before the fix: read (1.2 GB), then refused
+  // Within the pixel limit but more than the file can hold.
+  put_be32(16, 2048);
+  put_be32(20, 2048);
+  put_be32(29, static_cast<std::uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(png.data() + 12), 17)));
+  const std::string small = tf_error(dir.write("claims.png", png));
+  EXPECT_NE(small.find("claims 2048×2048×3 pixels, more than its"), std::string::npos) << small;
+  // A real image larger than a transfer function can be.
+  write_png(dir / "wide.png", 4096, 2048, std::vector<unsigned char>(4096 * 2048 * 3, 7));
+  EXPECT_NE(tf_error(dir / "wide.png").find("at most 4194304 pixels"), std::string::npos);
+}
+
+// issue 11: a transfer-function image of /dev/zero (or a FIFO) blocked forever.
+TEST(TransferFunctionImage, RefusesNonRegularFiles) {
+  ScratchDir dir;
+  EXPECT_NE(tf_error("/dev/zero").find("tf: image /dev/zero: is a character device"), std::string::npos)
+      << tf_error("/dev/zero");
+  ASSERT_EQ(::mkfifo((dir / "pipe.png").c_str(), 0600), 0);
+  EXPECT_NE(tf_error(dir / "pipe.png").find("FIFO"), std::string::npos);
+}
+
+// issue 11: a truncated PNG printed libpng's own lines; its message is now part of the one error.
+TEST(TransferFunctionImage, TruncatedPngIsOneError) {
+  ScratchDir dir;
+  std::vector<unsigned char> px(64 * 64 * 3);
+  for (std::size_t i = 0; i < px.size(); ++i) px[i] = static_cast<unsigned char>((i * 7919) % 251);
+  write_png(dir / "full.png", 64, 64, px);
+  std::ifstream in(dir / "full.png", std::ios::binary);
+  const std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto cut = dir.write("cut.png", png.substr(0, png.size() / 2));
+  ::testing::internal::CaptureStderr();
+  const std::string msg = tf_error(cut);
+  const std::string printed = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(msg.find("cannot read image"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  EXPECT_EQ(printed, "");
 }
 
 }  // namespace

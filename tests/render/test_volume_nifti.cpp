@@ -3,11 +3,14 @@
 // and the real Colin27 template from Debian's mricron-data when it is installed.
 #include <gtest/gtest.h>
 #include <nifti1_io.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iterator>
+#include <limits>
 
 #include "prizma/render/volume.h"
 #include "prizma/spectral/error.h"
@@ -136,12 +139,68 @@ TEST(NiftiVolume, CorruptAndTruncatedFilesAreInputErrors) {
   expect_input_error(dir / "absent.nii", "no such file");
 }
 
+// Reads a file's bytes; writes bytes back.
+std::string read_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+void put_float(std::string& bytes, std::size_t offset, float v) { std::memcpy(bytes.data() + offset, &v, sizeof v); }
+
 TEST(NiftiVolume, ZeroAndNegativePixdim) {
-  // libnifti reads a pixdim of 0 as 1 (nifti_convert_nhdr2nim); a negative one gives its magnitude.
+  // A negative pixdim gives its magnitude; a 0 on an axis of one voxel is harmless (spacing 1).
   ScratchDir dir;
   const auto path = dir / "flat.nii";
-  write_nifti<std::uint8_t>(path, DT_UINT8, {2, 2, 2}, 1, {2.0f, 0.0f, -3.0f}, ramp);
-  EXPECT_EQ(load_nifti_volume(path).spacing, (std::array<double, 3>{2.0, 1.0, 3.0}));
+  write_nifti<std::uint8_t>(path, DT_UINT8, {2, 2, 1}, 1, {2.0f, -3.0f, 0.0f}, ramp);
+  EXPECT_EQ(load_nifti_volume(path).spacing, (std::array<double, 3>{2.0, 3.0, 1.0}));
+}
+
+// issue 11: pixdim 0, NaN or inf on an axis of more than one voxel was read as 1 (libnifti turns
+// 0 into 1); docs/scene-format.md says it is refused.
+TEST(NiftiVolume, RefusesZeroNanOrInfinitePixdimOnARealAxis) {
+  ScratchDir dir;
+  const auto path = dir / "v.nii";
+  write_nifti<std::uint8_t>(path, DT_UINT8, {2, 2, 2}, 1, {1, 1, 1}, ramp);
+  const std::string good = read_bytes(path);
+  for (float bad : {0.0f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    std::string bytes = good;
+    put_float(bytes, 76 + 4 * 2, bad);  // pixdim[2]
+    expect_input_error(dir.write("bad.nii", bytes), "pixdim[2] must be a finite non-zero voxel size");
+  }
+}
+
+// issue 11: a negative vox_offset read the voxels from offset 348 (shifted by 4 bytes).
+TEST(NiftiVolume, RefusesAVoxOffsetInsideTheHeader) {
+  ScratchDir dir;
+  const auto path = dir / "v.nii";
+  write_nifti<std::uint8_t>(path, DT_UINT8, {2, 2, 2}, 1, {1, 1, 1}, ramp);
+  for (float bad : {-4.0f, 0.0f, 100.0f, 352.5f}) {
+    std::string bytes = read_bytes(path);
+    put_float(bytes, 108, bad);
+    expect_input_error(dir.write("off.nii", bytes), "vox_offset");
+  }
+}
+
+// issue 11: a .nii.gz whose gzip trailer (CRC-32 and length) is missing was accepted.
+TEST(NiftiVolume, RefusesAGzipStreamWithoutItsTrailer) {
+  ScratchDir dir;
+  const auto path = dir / "v.nii.gz";
+  write_nifti<float>(path, DT_FLOAT32, {4, 4, 4}, 1, {1, 1, 1}, ramp);
+  const std::string bytes = read_bytes(path);
+  EXPECT_NO_THROW(load_nifti_volume(path));
+  expect_input_error(dir.write("cut.nii.gz", bytes.substr(0, bytes.size() - 8)), "gzip");
+  std::string bad_crc = bytes;
+  bad_crc[bad_crc.size() - 6] = static_cast<char>(bad_crc[bad_crc.size() - 6] ^ 0x5a);
+  // A wrong CRC: refused by libnifti's header read when the stream is this short, by the trailer
+  // check otherwise.
+  expect_input_error(dir.write("crc.nii.gz", bad_crc), "");
+}
+
+// issue 11: a FIFO blocked the loader forever; non-regular files are refused up front.
+TEST(NiftiVolume, RefusesNonRegularFiles) {
+  ScratchDir dir;
+  ASSERT_EQ(::mkfifo((dir / "pipe.nii").c_str(), 0600), 0);
+  expect_input_error(dir / "pipe.nii", "FIFO");
+  expect_input_error("/dev/zero", "character device");
 }
 
 TEST(NiftiVolume, ReadsColin27Template) {

@@ -143,7 +143,7 @@ TEST(RawVolume, RejectsMissingFile) {
   ScratchDir dir;
   RawVolumeSpec spec;
   spec.path = dir / "absent_2x2x2_uint8.raw";
-  expect_input_error(spec, "cannot read");
+  expect_input_error(spec, "no such file");
 }
 
 TEST(RawVolume, RejectsNonPositiveDimsAndSpacing) {

@@ -1,6 +1,7 @@
 // The spectral EXR layout: round trips, the published single-layer layout written by plain OpenEXR
 // code, and the refusals of read_spectral_exr.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <ImfChannelList.h>
@@ -9,6 +10,8 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfVecAttribute.h>
 #include <ImfOutputFile.h>
 #include <ImfPreviewImage.h>
 #include <ImfStringAttribute.h>
@@ -405,7 +408,7 @@ TEST_F(SpectralExr, RefusesNonExrBytes) {
   const std::string err = read_error(p);
   EXPECT_NE(err.find(p.string()), std::string::npos) << err;
   EXPECT_NE(err.find("not an OpenEXR file"), std::string::npos) << err;
-  EXPECT_NE(read_error(file("missing.exr")).find("does not exist"), std::string::npos);
+  EXPECT_NE(read_error(file("missing.exr")).find("no such file"), std::string::npos);
 }
 
 TEST_F(SpectralExr, RefusesTruncatedFile) {
@@ -647,4 +650,87 @@ TEST_F(SpectralExr, ReadsDataWindowNotAtOrigin) {
   EXPECT_EQ(img.width, 3);
   EXPECT_EQ(img.height, 2);
   EXPECT_EQ(img.lights[0].data, px);
+}
+
+// issue 11: oiiotool rewrites a float array of 2, 3, 9 or 16 values as v2f, v3f, m33f or m44f;
+// the reader ignored those and fell back to midpoint edges (~10× off for non-uniform bins).
+TEST_F(SpectralExr, ReadsBinEdgesInEveryNumericFormOpenExrHolds) {
+  auto edges_of = [](int n) {
+    std::vector<double> e;
+    for (int i = 0; i <= n; ++i) e.push_back(400.0 + 300.0 * (i * i) / (n * n) + 3.0 * i);  // non-uniform
+    return e;
+  };
+  struct Form {
+    int bins;
+    std::function<void(Imf::Header&, const std::vector<float>&)> put;
+  };
+  const std::vector<Form> forms = {
+      {1, [](Imf::Header& h, const std::vector<float>& e) { h.insert("prizma:binEdgesNm", Imf::V2fAttribute({e[0], e[1]})); }},
+      {2, [](Imf::Header& h, const std::vector<float>& e) {
+         h.insert("prizma:binEdgesNm", Imf::V3fAttribute({e[0], e[1], e[2]}));
+       }},
+      {2, [](Imf::Header& h, const std::vector<float>& e) {
+         h.insert("prizma:binEdgesNm", Imf::V3dAttribute({e[0], e[1], e[2]}));
+       }},
+      {8, [](Imf::Header& h, const std::vector<float>& e) {
+         h.insert("prizma:binEdgesNm", Imf::M33fAttribute(Imath::M33f(e[0], e[1], e[2], e[3], e[4], e[5], e[6], e[7], e[8])));
+       }},
+      {15, [](Imf::Header& h, const std::vector<float>& e) {
+         Imath::M44f m;
+         for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = e[static_cast<std::size_t>(i)];
+         h.insert("prizma:binEdgesNm", Imf::M44fAttribute(m));
+       }},
+  };
+  for (const Form& form : forms) {
+    SCOPED_TRACE(form.bins);
+    const BinLayout bins = BinLayout::from_edges(edges_of(form.bins));
+    const fs::path p = file("edges.exr");
+    write_spectral_exr(p, make_image(2, 2, bins, {"a"}));
+    std::vector<float> fe(bins.edges_nm().begin(), bins.edges_nm().end());
+    const fs::path q = rewrite_header(p, file("copied.exr"), [&](Imf::Header& h) {
+      h.erase("prizma:binEdgesNm");
+      form.put(h, fe);
+    });
+    const SpectralImage img = read_spectral_exr(q);
+    ASSERT_EQ(img.bins.size(), form.bins);
+    for (int i = 0; i <= form.bins; ++i) EXPECT_NEAR(img.bins.edges_nm()[i], bins.edges_nm()[i], 1e-12) << i;
+  }
+}
+
+// issue 11: edges whose bins do not have the channels' wavelengths as centres were accepted.
+TEST_F(SpectralExr, RefusesRecordedEdgesThatDisagreeWithTheChannels) {
+  const fs::path p = file("edges.exr");
+  write_spectral_exr(p, make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"}));  // centres 450, 550, 650
+  const fs::path q = rewrite_header(p, file("moved.exr"), [&](Imf::Header& h) {
+    h.insert("prizma:binEdgesNm", Imf::FloatVectorAttribute({400, 470, 560, 700}));
+    h.erase("prizma:binEdgesNmExact");
+  });
+  std::string err = read_error(q);
+  EXPECT_NE(err.find("is not the centre 435 nm of its bin [400, 470]"), std::string::npos) << err;
+  const fs::path r = rewrite_header(p, file("string.exr"), [&](Imf::Header& h) {
+    h.erase("prizma:binEdgesNm");
+    h.insert("prizma:binEdgesNm", Imf::StringAttribute("400 500 600 700"));
+  });
+  err = read_error(r);
+  EXPECT_NE(err.find("prizma:binEdgesNm has type string"), std::string::npos) << err;
+}
+
+// issue 11: a FIFO or a device given as the EXR blocked forever.
+TEST_F(SpectralExr, RefusesNonRegularFiles) {
+  ASSERT_EQ(::mkfifo(file("pipe.exr").c_str(), 0600), 0);
+  EXPECT_NE(read_error(file("pipe.exr")).find("is a FIFO (named pipe)"), std::string::npos) << read_error(file("pipe.exr"));
+  EXPECT_NE(read_error("/dev/zero").find("/dev/zero: is a character device"), std::string::npos);
+  fs::create_directory(file("folder.exr"));
+  EXPECT_NE(read_error(file("folder.exr")).find("is a folder, not an OpenEXR file"), std::string::npos)
+      << read_error(file("folder.exr"));
+}
+
+// issue 11: a deeply nested prizma:lights record is refused (nlohmann recurses on such values).
+TEST_F(SpectralExr, RefusesDeeplyNestedLightsJson) {
+  SpectralImage img = make_image(1, 1, BinLayout::linear(400, 700, 2), {"a"});
+  img.info.lights_json = std::string(70000, '[') + std::string(70000, ']');
+  const fs::path p = file("deep.exr");
+  write_spectral_exr(p, img);
+  const std::string err = read_error(p);
+  EXPECT_NE(err.find("prizma:lights: JSON nested deeper than"), std::string::npos) << err;
 }

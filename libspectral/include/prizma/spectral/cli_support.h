@@ -12,6 +12,7 @@ namespace prizma::spectral {
 // "prog: error: <message>" and "Try 'prog --help'." to stderr and returns kExitUsage. Returns -1 when
 // parsing succeeded and the program should go on.
 inline int parse_command_line(CLI::App& app, int argc, const char* const* argv) {
+  end_startup_guard();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {

@@ -26,8 +26,9 @@ struct RenderProgress {
 struct RenderCallbacks {
   // Called from the calling thread between passes; may be empty.
   std::function<void(const RenderProgress&)> progress;
-  // When set and true at the end of a pass, render() stops and returns the completed passes: a
-  // valid image with a true, uniform sample count (info.samples, info.sampleRange shortened).
+  // Polled at every sample: once true, render() abandons the current pass and returns the
+  // completed passes: a valid image with a true, uniform sample count (info.samples,
+  // info.sampleRange shortened).
   const std::atomic<bool>* cancel = nullptr;
   // Samples per pixel per pass; 0 = automatic (about 2^22 paths per pass, at least 1 sample).
   std::int64_t samples_per_pass = 0;

@@ -107,4 +107,11 @@ struct Scene {
 // "scene.json: materials[1].extinction.scale: must be > 0". Paths are relative to the scene file.
 Scene load_scene(const std::filesystem::path& path);
 
+// A command-line value for an integer scene field ("camera.width", "camera.height", "samples",
+// "seed", "max_bounces"), checked exactly as load_scene checks the field (same type, same range).
+// `text` is what the user typed; errors are InputError with input `option` ("--width").
+std::int64_t scene_integer_override(const std::string& text, const std::string& field, const std::string& option);
+// The same for "seed" (an integer in [0, 2^64 − 1]).
+std::uint64_t scene_seed_override(const std::string& text, const std::string& option);
+
 }  // namespace prizma::render
