@@ -38,14 +38,6 @@ SampleRange SampleRange::starting_at(std::int64_t begin, std::int64_t count, con
   return {begin, begin + count};
 }
 
-std::int64_t parse_sample_count(std::string_view text, const std::string& input) {
-  std::int64_t n = 0;
-  if (!parse_index(text, n) || n < 1 || n > kMaxSamplesPerPixel)
-    throw InputError(input, "must be a whole number of samples per pixel from 1 to 2^40 (1099511627776), got \"" +
-                                std::string(text) + "\"");
-  return n;
-}
-
 std::string SampleRange::to_string() const { return std::to_string(begin) + ":" + std::to_string(end); }
 
 std::vector<SampleRange> parse_sample_ranges(std::string_view text, const std::string& input) {

@@ -52,16 +52,6 @@ TEST(SampleRange, StartingAtRefusesOverflowWithTheReason) {
   EXPECT_THROW(SampleRange::starting_at(0, -3, "--spp"), InputError);
 }
 
-TEST(SampleRange, CountsAreWholeNumbersInTheScenesRange) {
-  EXPECT_EQ(parse_sample_count("64", "--spp"), 64);
-  EXPECT_EQ(parse_sample_count("1099511627776", "--spp"), kMaxSamplesPerPixel);
-  for (const char* bad : {"", "0", "-3", "+4", "1e3", "4.0", "1099511627777", "18446744073709551613",
-                          "99999999999999999999999"}) {
-    const std::string e = input_error([&] { parse_sample_count(bad, "--spp"); });
-    EXPECT_NE(e.find("from 1 to 2^40"), std::string::npos) << bad << ": " << e;
-  }
-}
-
 TEST(SampleRange, ListsJoinAndKeepGaps) {
   const auto r = parse_sample_ranges("16:24,0:8,8:16", "x");
   ASSERT_EQ(r.size(), 3u);

@@ -29,10 +29,6 @@ struct SampleRange {
   friend auto operator<=>(const SampleRange&, const SampleRange&) = default;
 };
 
-// "N" → a sample count 1 … kMaxSamplesPerPixel (decimal digits only: no sign, no exponent, no
-// wrap-around of huge values); throws InputError(input, …) saying the range otherwise.
-std::int64_t parse_sample_count(std::string_view text, const std::string& input);
-
 // "0:8" or "0:8,16:24" → the ranges as written; throws InputError(input, …) for anything else.
 std::vector<SampleRange> parse_sample_ranges(std::string_view text, const std::string& input);
 // Sorted, touching ranges joined: {16:24, 0:8, 8:16} → "0:24"; {0:8, 16:24} → "0:8,16:24".
