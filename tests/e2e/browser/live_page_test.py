@@ -188,8 +188,16 @@ def cli_args(state):
 def read_png(path):
     import OpenImageIO as oiio
     import numpy as np
-    buf = oiio.ImageBuf(path)
-    return np.asarray(buf.get_pixels(oiio.UINT8)).reshape(buf.spec().height, buf.spec().width, -1)[:, :, :3]
+    # ImageInput, not ImageBuf: an ImageBuf goes through OpenImageIO's shared ImageCache, which keys
+    # on the file name and modification time, so saved.png rewritten within the same second would
+    # read back as the previous image.
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise RuntimeError("cannot read %s: %s" % (path, oiio.geterror()))
+    spec = inp.spec()
+    pixels = inp.read_image(oiio.UINT8)
+    inp.close()
+    return np.asarray(pixels).reshape(spec.height, spec.width, -1)[:, :, :3]
 
 
 READ_CANVAS = """
