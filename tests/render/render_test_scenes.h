@@ -75,6 +75,17 @@ inline void randomise_density(Scene& s, float lo, float hi, unsigned seed = 3) {
   for (float& d : s.medium.density) d = dist(gen);
 }
 
+// A small chromatic heterogeneous box (wavelength-dependent albedo and extinction, random density)
+// under one directional light: the determinism and resume tests' scene.
+inline Scene chromatic_scene(std::int64_t spp) {
+  Scene s = box_scene(make_material(spectral::Spectrum({400.0, 700.0}, {0.95, 0.7}),
+                                    spectral::Spectrum({400.0, 700.0}, {4.0, 1.0}), spectral::Spectrum::constant(0.5)),
+                      8, 12, spp);
+  randomise_density(s, 0.0f, 2.0f);
+  s.lights.push_back(directional_light("sun", {0.5, 1, 0.2}));
+  return s;
+}
+
 // Per bin: the mean over all pixels of a layer and its standard error from the variance layer
 // (pixels are independent, so var(mean over P pixels) = Σ var_p / P²).
 struct BinEstimate {

@@ -14,15 +14,7 @@ namespace {
 
 using spectral::Spectrum;
 
-Scene chromatic_scene(std::int64_t spp) {
-  Scene s = testing::box_scene(testing::make_material(Spectrum({400.0, 700.0}, {0.95, 0.7}),
-                                                      Spectrum({400.0, 700.0}, {4.0, 1.0}),
-                                                      Spectrum::constant(0.5)),
-                               8, 12, spp);
-  testing::randomise_density(s, 0.0f, 2.0f);
-  s.lights.push_back(testing::directional_light("sun", {0.5, 1, 0.2}));
-  return s;
-}
+using testing::chromatic_scene;
 
 bool same_bits(const spectral::SpectralImage& a, const spectral::SpectralImage& b) {
   if (a.lights.size() != b.lights.size()) return false;

@@ -83,12 +83,7 @@ TEST(RenderOverrides, JsonRoundTrip) {
 }
 
 Scene chromatic_scene(std::int64_t spp) {
-  Scene s = testing::box_scene(testing::make_material(Spectrum({400.0, 700.0}, {0.95, 0.7}),
-                                                      Spectrum({400.0, 700.0}, {4.0, 1.0}),
-                                                      Spectrum::constant(0.5)),
-                               8, 12, spp);
-  testing::randomise_density(s, 0.0f, 2.0f);
-  s.lights.push_back(testing::directional_light("sun", {0.5, 1, 0.2}));
+  Scene s = testing::chromatic_scene(spp);
   s.settings.write_variance = true;
   return s;
 }
