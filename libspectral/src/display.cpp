@@ -13,6 +13,7 @@
 
 #include "prizma/spectral/data_path.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/tool_main.h"
 
 namespace OCIO = OCIO_NAMESPACE;
 
@@ -90,7 +91,7 @@ DisplayTransform::DisplayTransform(const DisplayOptions& opts) : m_impl(std::mak
     impl.config->validate();
   } catch (const OCIO::Exception& e) {
     // OCIO wraps a failed allocation in its own exception: that is not the config's fault.
-    if (std::string_view(e.what()).find("bad_alloc") != std::string_view::npos) {
+    if (message_says_out_of_memory(e.what())) {
       throw RuntimeError(cfg + ": out of memory loading the OCIO config (" + e.what() + ")");
     }
     throw InputError(cfg, std::string("cannot load OCIO config: ") + e.what());

@@ -443,8 +443,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
     } catch (const std::exception& e) {
       // OpenEXR's threads that cannot start (EAGAIN) or allocate: out of memory, said so.
       const std::string what = e.what();
-      if (is_out_of_memory(e) || what.find("Resource temporarily unavailable") != std::string::npos ||
-          what.find("ut of memory") != std::string::npos || what.find("bad_alloc") != std::string::npos) {
+      if (is_out_of_memory(e) || message_says_out_of_memory(what)) {
         throw RuntimeError(p + ": out of memory writing the OpenEXR file (" + what + ")");
       }
       throw RuntimeError(p + ": cannot write OpenEXR file: " + e.what());
@@ -870,10 +869,9 @@ SpectralImage read_spectral_exr(const fs::path& path) {
   } catch (const std::exception& e) {
     // OpenEXR (Iex) exceptions: truncated or corrupt files. Its worker threads report a failed
     // allocation as an Iex message ("Out of memory", "std::bad_alloc"): that is not the file's fault.
+    // The message quotes channel names from the file, which may spell those words themselves.
     const std::string what = e.what();
-    if (what.find("ut of memory") != std::string::npos || what.find("bad_alloc") != std::string::npos ||
-        what.find("Cannot allocate memory") != std::string::npos ||
-        what.find("Resource temporarily unavailable") != std::string::npos) {
+    if (message_says_out_of_memory(what)) {
       throw RuntimeError(p + ": out of memory reading the pixels (" + what + ")");
     }
     throw InputError(p, std::string("cannot read OpenEXR file (truncated or corrupt?): ") + e.what());

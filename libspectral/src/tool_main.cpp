@@ -45,6 +45,24 @@ bool is_out_of_memory(const std::exception& e) {
   return std::string_view(e.what()).find("pthread_create has failed") != std::string_view::npos;
 }
 
+bool message_says_out_of_memory(std::string_view what) {
+  std::string unquoted;
+  unquoted.reserve(what.size());
+  bool quoted = false;
+  for (const char ch : what) {
+    if (ch == '"') {
+      quoted = !quoted;
+    } else if (!quoted) {
+      unquoted += ch;
+    }
+  }
+  for (const std::string_view marker :
+       {"ut of memory", "bad_alloc", "Cannot allocate memory", "Resource temporarily unavailable"}) {
+    if (unquoted.find(marker) != std::string::npos) return true;
+  }
+  return false;
+}
+
 void report_uncaught_and_exit(const char* program) noexcept {
   // stdio only and no allocation: this may run before the C++ library's own initialisation
   // (iostreams), and memory may be exhausted.

@@ -37,6 +37,11 @@ bool is_out_of_resources(const std::system_error& e);
 // True for every way running out of memory shows: std::bad_alloc, the system_errors above, and
 // TBB's "pthread_create has failed" (a std::runtime_error when it cannot start a worker).
 bool is_out_of_memory(const std::exception& e);
+// True when a library's error message (OpenEXR's Iex, OCIO) says that memory or threads ran out:
+// "Out of memory", "std::bad_alloc", "Cannot allocate memory", "Resource temporarily unavailable".
+// Text in double quotes is ignored: those messages quote file names and channel names, which come
+// from the input and may contain these very words (a channel named "Cannot allocate memory").
+bool message_says_out_of_memory(std::string_view what);
 
 // Runs f(); running out of memory inside it (std::bad_alloc, or a thread that cannot be started)
 // becomes RuntimeError("out of memory <what>"), e.g. what = "reading the scene's volume".

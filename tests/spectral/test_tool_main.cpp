@@ -1,0 +1,28 @@
+// Out-of-memory classification of library error messages (tool_main.h): a file's own text never
+// turns a corrupt-file error into "out of memory".
+#include <gtest/gtest.h>
+
+#include "prizma/spectral/tool_main.h"
+
+namespace prizma::spectral {
+namespace {
+
+TEST(ToolMain, LibraryMessagesThatMeanOutOfMemory) {
+  EXPECT_TRUE(message_says_out_of_memory("std::bad_alloc"));
+  EXPECT_TRUE(message_says_out_of_memory("Out of memory"));
+  EXPECT_TRUE(message_says_out_of_memory("Cannot read image file \"a.exr\". Cannot allocate memory"));
+  EXPECT_TRUE(message_says_out_of_memory("Cannot create thread: Resource temporarily unavailable"));
+}
+
+TEST(ToolMain, QuotedFileTextIsNotOutOfMemory) {
+  // The fuzzer's input: a channel named "aCannot allocate memory" with an invalid pixel type.
+  EXPECT_FALSE(message_says_out_of_memory(
+      "Cannot read image file \"/tmp/input.exr\". Pixel type of \"aCannot allocate memory\" image channel is invalid."));
+  EXPECT_FALSE(message_says_out_of_memory("Cannot read image file \"/data/bad_alloc/x.exr\". Unexpected end of file."));
+  EXPECT_FALSE(message_says_out_of_memory("Unexpected end of file."));
+  // An unbalanced quote hides the rest: the message is then not taken as out of memory.
+  EXPECT_FALSE(message_says_out_of_memory("channel \"std::bad_alloc"));
+}
+
+}  // namespace
+}  // namespace prizma::spectral
