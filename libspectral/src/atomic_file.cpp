@@ -359,7 +359,7 @@ void write_atomically(const fs::path& path, const std::function<void(AtomicOutpu
   }
   if (problem.empty()) {
     fd_open = false;
-    if (::close(fd) != 0) problem = errno_text(errno);
+    if (::close(fd) != 0) problem = "cannot close the temporary (" + errno_text(errno) + ")";
   }
   if (!problem.empty()) {
     abandon();

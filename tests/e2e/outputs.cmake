@@ -13,13 +13,25 @@ if(NOT PRIZMA_SYSTEM_PYTHON3)
 endif()
 
 set(_outputs_work ${PRIZMA_E2E_WORK}/outputs)
+# The failing-system-call library of the io_faults case. Not in sanitizer builds: their runtime
+# defines close() in the executable, which an LD_PRELOAD library cannot replace.
+if(NOT PRIZMA_SANITIZE AND NOT PRIZMA_FUZZ)
+  add_library(prizma_test_io_faults MODULE ${PRIZMA_E2E_DIR}/outputs/io_faults.cpp)
+  target_link_libraries(prizma_test_io_faults PRIVATE ${CMAKE_DL_LIBS})
+  prizma_set_warnings(prizma_test_io_faults)
+endif()
 set(_outputs_cmd ${PRIZMA_SYSTEM_PYTHON3} ${PRIZMA_E2E_DIR}/outputs/check-outputs
     --render $<TARGET_FILE:prizma-render> --relight $<TARGET_FILE:prizma-relight>
     --metamer $<TARGET_FILE:prizma-metamer> --scene ${PRIZMA_E2E_DIR}/render/tiny.json --work ${_outputs_work})
 add_test(NAME outputs.e2e.fixture COMMAND ${_outputs_cmd} fixture)
 set_tests_properties(outputs.e2e.fixture PROPERTIES FIXTURES_SETUP outputs_files LABELS outputs
                      ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
-foreach(case fsize_relight fsize_render fsize_metamer special_outputs symlink_outputs same_file prework_render stdout)
+set(_outputs_cases fsize_relight fsize_render fsize_metamer special_outputs symlink_outputs same_file prework_render stdout)
+if(TARGET prizma_test_io_faults)
+  list(APPEND _outputs_cases io_faults)
+  list(APPEND _outputs_cmd --io-faults $<TARGET_FILE:prizma_test_io_faults>)
+endif()
+foreach(case ${_outputs_cases})
   add_test(NAME outputs.e2e.${case} COMMAND ${_outputs_cmd} ${case})
   set_tests_properties(outputs.e2e.${case} PROPERTIES FIXTURES_REQUIRED outputs_files LABELS outputs TIMEOUT 300
                        ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
