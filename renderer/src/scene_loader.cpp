@@ -413,9 +413,18 @@ Camera read_camera(const Reader& rd, const json& j) {
     else if (t == "orthographic") c.type = CameraType::Orthographic;
     else rd.fail(tp, "must be \"perspective\" or \"orthographic\" (got \"" + t + "\")");
   }
+  // Coordinates beyond 1e12 scene units leave the ray no precision to resolve a volume (and their
+  // squares overflow past 1e154): refused rather than rendered as an empty picture.
+  constexpr double kMaxCoordinate = 1e12;
   auto vec = [&](const char* key, Eigen::Vector3d& out) {
     if (!j.contains(key)) return;
-    const auto v = rd.vec3(j.at(key), Reader::join(path, key));
+    const std::string kp = Reader::join(path, key);
+    const auto v = rd.vec3(j.at(key), kp);
+    for (int i = 0; i < 3; ++i) {
+      if (!(std::abs(v[i]) <= kMaxCoordinate)) {
+        rd.fail(Reader::index(kp, i), "must be within ±1e12 (got " + num(v[i]) + ")");
+      }
+    }
     out = Eigen::Vector3d(v[0], v[1], v[2]);
   };
   vec("position", c.position);

@@ -363,6 +363,12 @@ TEST(SceneLoaderErrors, CameraAndSettings) {
   j["camera"]["up"] = {0, 0, -1};
   expect_error(dir, j, "camera.up", "parallel");
   j = base_scene();
+  j["camera"]["position"] = {1e200, 0.5, 0.5};  // its square overflows: once "up parallel", misleading
+  expect_error(dir, j, "camera.position[0]", "must be within ±1e12 (got 1e+200)");
+  j = base_scene();
+  j["camera"]["look_at"] = {0, -1e13, 0};
+  expect_error(dir, j, "camera.look_at[1]", "must be within ±1e12");
+  j = base_scene();
   j["camera"]["type"] = "fisheye";
   expect_error(dir, j, "camera.type", "perspective");
   j = base_scene();
