@@ -141,6 +141,11 @@ class Shell {
     refresh();
   }
 
+  // The line that ends every command that does not relight: its own time and the last relight's.
+  std::string timing(const char* done, std::chrono::steady_clock::time_point start) const {
+    return std::string(done) + " in " + ms_text(ms_since(start)) + " (last relight " + ms_text(m_last_relight_ms) + ")\n";
+  }
+
   void status() {
     const RelightSettings& s = m_session.settings();
     const auto& img = m_session.image();
@@ -229,7 +234,9 @@ void run_command(RelightSession& session, Shell& shell, std::ostream& out, const
       forced = parse_image_protocol(w[1]);
       if (!forced) throw InputError("show", "blocks, sixel or kitty, not \"" + w[1] + "\"");
     }
+    const auto start = std::chrono::steady_clock::now();
     shell.draw(forced);
+    out << shell.timing("drawn", start);
   } else if (cmd == "save") {
     expect_args(w, 1, 1, "save FILE");
     const auto start = std::chrono::steady_clock::now();
@@ -237,6 +244,7 @@ void run_command(RelightSession& session, Shell& shell, std::ostream& out, const
     out << "saved " << w[1] << " in " << ms_text(ms_since(start)) << "\n";
   } else if (cmd == "probe") {
     expect_args(w, 2, 2, "probe X Y");
+    const auto start = std::chrono::steady_clock::now();
     const ProbeResult r = session.probe(to_index(w[1], "probe X", width, size), to_index(w[2], "probe Y", height, size));
     out << "probe " << r.x << ' ' << r.y << "\n";
     for (std::size_t l = 0; l < r.bins.size(); ++l) {
@@ -245,8 +253,10 @@ void run_command(RelightSession& session, Shell& shell, std::ostream& out, const
       out << "\n";
     }
     out << "  XYZ " << vec3(r.xyz) << "\n  Lab " << vec3(r.lab) << "\n  sRGB " << vec3(r.srgb) << "\n";
+    out << "  " << shell.timing("probed", start);
   } else if (cmd == "compare") {
     expect_args(w, 4, 5, "compare X1 Y1 X2 Y2 [R]");
+    const auto start = std::chrono::steady_clock::now();
     const int r = w.size() == 6 ? to_index(w[5], "compare R", std::max(width, height) + 1, "radius range of the " + size) : 0;
     const CompareResult c =
         session.compare(to_index(w[1], "compare X1", width, size), to_index(w[2], "compare Y1", height, size),
@@ -254,6 +264,7 @@ void run_command(RelightSession& session, Shell& shell, std::ostream& out, const
     std::ostringstream de;
     de << std::fixed << std::setprecision(6) << c.delta_e2000;
     out << "compare\n  Lab1 " << vec3(c.lab1) << "\n  Lab2 " << vec3(c.lab2) << "\n  dE2000 " << de.str() << "\n";
+    out << "  " << shell.timing("compared", start);
   } else {
     throw InputError(cmd, "unknown command (try 'help')");
   }

@@ -13,11 +13,17 @@ set(_live_work ${PRIZMA_E2E_WORK}/live_page)
 add_test(NAME relight.live.fixture COMMAND prizma_live_page_fixture ${_live_work})
 set_tests_properties(relight.live.fixture PROPERTIES FIXTURES_SETUP live_page_files)
 
+set(_live_mri "")
+set(_live_fixtures live_page_files)
+if(PRIZMA_E2E_MRI_EXR)
+  set(_live_mri --mri ${PRIZMA_E2E_MRI_EXR})
+  list(APPEND _live_fixtures mri_render)
+endif()
 foreach(mode server browser)
   add_test(NAME relight.live.${mode}
            COMMAND /usr/bin/python3 ${PRIZMA_E2E_DIR}/browser/live_page_test.py ${mode}
-                   $<TARGET_FILE:prizma-relight> ${_live_work})
-  set_tests_properties(relight.live.${mode} PROPERTIES FIXTURES_REQUIRED live_page_files
+                   $<TARGET_FILE:prizma-relight> ${_live_work} ${_live_mri})
+  set_tests_properties(relight.live.${mode} PROPERTIES FIXTURES_REQUIRED "${_live_fixtures}"
                        ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}" RESOURCE_LOCK live_page_work
                        TIMEOUT 300 SKIP_RETURN_CODE 77)
 endforeach()

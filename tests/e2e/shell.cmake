@@ -30,8 +30,15 @@ if(NOT PRIZMA_TMUX OR NOT PRIZMA_PYTHON3)
   message(WARNING "tmux or python3 not found: the terminal test of prizma-relight -i is not registered (scripts/setup installs tmux)")
   return()
 endif()
+set(_shell_mri "")
+set(_shell_fixtures relight_files)
+if(PRIZMA_E2E_MRI_EXR)
+  set(_shell_mri --mri ${PRIZMA_E2E_MRI_EXR})
+  list(APPEND _shell_fixtures mri_render)
+endif()
 add_test(NAME relight.e2e.shell_terminal
          COMMAND ${PRIZMA_PYTHON3} ${PRIZMA_E2E_DIR}/shell/tmux_shell_test.py $<TARGET_FILE:prizma-relight>
-                 ${_shell_relight_work}/scene.exr ${PRIZMA_E2E_WORK}/shell_terminal ${PRIZMA_SOURCE_DATA_DIR})
-set_tests_properties(relight.e2e.shell_terminal PROPERTIES FIXTURES_REQUIRED relight_files LABELS terminal
+                 ${_shell_relight_work}/scene.exr ${PRIZMA_E2E_WORK}/shell_terminal ${PRIZMA_SOURCE_DATA_DIR}
+                 ${_shell_mri})
+set_tests_properties(relight.e2e.shell_terminal PROPERTIES FIXTURES_REQUIRED "${_shell_fixtures}" LABELS terminal
                      TIMEOUT 300)

@@ -11,7 +11,8 @@
                                               channel on >= 99.9 % of the pixels, and "Save" must
                                               write the very same image
 
-WORKDIR holds two.exr and one.exr (make_fixture). Exit 77 (ctest SKIP_RETURN_CODE) when chromium,
+WORKDIR holds two.exr and one.exr (make_fixture). With --mri FILE (a render of data/scenes/mri.json,
+lights key and env) the browser test also draws that real-data file in several states. Exit 77 (ctest SKIP_RETURN_CODE) when chromium,
 chromedriver or selenium are missing; 1 on any failure.
 """
 import base64
@@ -213,7 +214,7 @@ return [c.width, c.height, btoa(s)];
 """
 
 
-def test_browser(relight, workdir):
+def test_browser(relight, workdir, mri=None):
     chromium = shutil.which("chromium")
     driver_path = shutil.which("chromedriver") or ("/usr/bin/chromedriver" if os.path.exists("/usr/bin/chromedriver") else None)
     try:
@@ -248,6 +249,14 @@ def test_browser(relight, workdir):
         ("one.exr", "light.key=D65&exposure=0&cmf=1931&display=sRGB&adapt=0", "a 1-bin file"),
         ("one.exr", "light.key=gaussian:550:40&exposure=1&cmf=2012-2&display=Display%20P3&adapt=1", "a 1-bin file, P3"),
     ]
+    if mri:
+        cases += [
+            (mri, "light.key=D65&light.env=D65*0.3&exposure=0&cmf=1931&display=sRGB&adapt=0", "the MRI render, its own lights"),
+            (mri, "light.key=blackbody:3200K&light.env=off&exposure=1&cmf=1931&display=Display%20P3&adapt=1",
+             "the MRI render, warm key light only, P3, adapted"),
+            (mri, "light.key=F11&light.env=LED-B3*0.5&exposure=-0.5&cmf=2012-2&display=sRGB&adapt=0",
+             "the MRI render, F11 and a blue LED"),
+        ]
     servers = {}
     refs = {}
     try:
@@ -302,11 +311,17 @@ def test_browser(relight, workdir):
 
 
 def main():
-    if len(sys.argv) != 4 or sys.argv[1] not in ("server", "browser"):
+    args = sys.argv[1:]
+    mri = None
+    if "--mri" in args:
+        i = args.index("--mri")
+        mri = os.path.abspath(args[i + 1])
+        del args[i:i + 2]
+    if len(args) != 3 or args[0] not in ("server", "browser"):
         print(__doc__)
         return 2
-    mode, relight, workdir = sys.argv[1], os.path.abspath(sys.argv[2]), os.path.abspath(sys.argv[3])
-    rc = test_server(relight, workdir) if mode == "server" else test_browser(relight, workdir)
+    mode, relight, workdir = args[0], os.path.abspath(args[1]), os.path.abspath(args[2])
+    rc = test_server(relight, workdir) if mode == "server" else test_browser(relight, workdir, mri)
     if rc == SKIP:
         return SKIP
     if failures:

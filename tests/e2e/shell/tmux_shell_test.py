@@ -8,7 +8,10 @@ errors, and that a history that cannot be written, or is not libedit's, is only 
 Every wait polls the screen until the expected text is there, with a bound (TIMEOUT_S); the tmux
 server is killed at the end whatever happened.
 
-usage: tmux_shell_test.py EXE SCENE.exr WORKDIR DATA_DIR [--transcript FILE]
+With --mri FILE a fifth session runs on that file (a render of data/scenes/mri.json): light names
+completed from its layers (key, env), a light changed and switched off, a probe, a show.
+
+usage: tmux_shell_test.py EXE SCENE.exr WORKDIR DATA_DIR [--transcript FILE] [--mri FILE]
 """
 import os
 import re
@@ -118,6 +121,11 @@ def main():
         i = args.index("--transcript")
         transcript = args[i + 1]
         del args[i:i + 2]
+    mri = None
+    if "--mri" in args:
+        i = args.index("--mri")
+        mri = os.path.abspath(args[i + 1])
+        del args[i:i + 2]
     exe, scene, work, data = args
     shutil.rmtree(work, ignore_errors=True)
     state = os.path.join(work, "state")
@@ -177,6 +185,8 @@ def main():
         screen = pane.command("show")
         expect("\u2580" in screen, "show drew no half blocks", screen)
         expect(screen.count("relit in ") >= 6, "changes did not print their relight time", screen)
+        expect(re.search(r"drawn in [0-9.]+ ms \(last relight [0-9.]+ ms\)", screen) is not None,
+               "show did not print its time", screen)
         pane.type("quit")
         pane.key("Enter")
         pane.wait("the first session to end", lambda s: "[exited 0]" in s)
@@ -231,6 +241,28 @@ def main():
         pane.wait("the fourth session to end", lambda s: "[exited 0]" in s)
         with open(foreign) as f:
             expect(f.read() == "my own notes\n", "the foreign history file was overwritten")
+        if mri:
+            # Session 5: the MRI render, through the same keys.
+            pane.start(session_command(exe, mri, env))
+            screen = pane.wait_prompt(1)
+            expect("relit in " in screen and "error" not in screen, "the MRI file did not open", screen)
+            pane.type("light e")
+            pane.key("Tab")
+            pane.wait("the MRI's light name completed", lambda s: pane.last_line() == f"{PROMPT} light env")
+            pane.type(" off")
+            pane.key("Enter")
+            pane.wait_prompt(2)
+            pane.command("light key blackbody:3200K")
+            screen = pane.command("status")
+            for want in ["light       key = blackbody:3200K (default D65)", "light       env = off (default D65*0.3)"]:
+                expect(want in screen, f"MRI status does not show '{want}'", screen)
+            screen = pane.command("probe 24 24")
+            expect(re.search(r"probed in [0-9.]+ ms", screen) is not None, "MRI probe printed no time", screen)
+            screen = pane.command("show")
+            expect("\u2580" in screen and "error" not in screen, "show drew no MRI image", screen)
+            pane.type("quit")
+            pane.key("Enter")
+            pane.wait("the MRI session to end", lambda s: "[exited 0]" in s)
         print("terminal session test passed")
         return 0
     except Failure as e:
