@@ -31,10 +31,15 @@ prizma_progress() {
 prizma_build_installed() {
   local root="$1" build="$2" args=()
   mkdir -p "$build"
-  # A new build folder gets no tests (faster); an existing one keeps its settings.
-  [[ -f "$build/CMakeCache.txt" ]] || args+=(-DPRIZMA_BUILD_TESTS=OFF)
+  # A new build folder gets no tests (faster); an existing one keeps its settings (scripts/build
+  # would otherwise turn -Werror off in a tree scripts/test built with it, and recompile everything).
+  if [[ -f "$build/CMakeCache.txt" ]]; then
+    grep -q '^PRIZMA_WERROR:BOOL=ON$' "$build/CMakeCache.txt" && export PRIZMA_WERROR=1
+  else
+    args+=(-DPRIZMA_BUILD_TESTS=OFF)
+  fi
   local jobs="${PRIZMA_JOBS:-$(nproc)}"
-  echo "  building in $build with $jobs jobs (log: $build/build.log); the first build takes a few minutes per core" >&2
+  echo "  building in $build with $jobs jobs (log: $build/build.log); a first build from nothing takes about 20 minutes on one core" >&2
   if ! PRIZMA_BUILD_DIR="$build" PRIZMA_BUILD_TARGETS=prizma-installed "$root/scripts/build" "${args[@]}" 2>&1 \
       | prizma_progress "$build/build.log"; then
     echo "prizma: the build failed; the end of $build/build.log:" >&2
