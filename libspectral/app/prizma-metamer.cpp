@@ -16,6 +16,7 @@
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/colour_matching.h"
+#include "prizma/spectral/data_path.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/light_design.h"
@@ -31,7 +32,18 @@ struct CommonOptions {
   std::string bins;
   std::string cmf = "1931";
   bool verbose = false;
+  bool quiet = false;
+  int threads = 0;
 };
+
+// -v: what the colours are computed with, on stderr.
+void describe(const CommonOptions& common, const ps::ColourSetting& colour) {
+  if (!common.verbose) return;
+  std::fprintf(stderr, "prizma-metamer: observer %s, bins %s, data %s\n", ps::observer_name(colour.observer).c_str(),
+               colour.bins.to_string().c_str(), ps::data_dir().string().c_str());
+  const std::string note = ps::cmf_coverage_note(ps::ColorMatching::get(colour.observer), colour.bins);
+  if (!note.empty()) std::fprintf(stderr, "prizma-metamer: note: %s\n", note.c_str());
+}
 
 struct MetamerCommand {
   std::string albedo;
@@ -81,6 +93,7 @@ ps::ColourSetting colour_setting(const CommonOptions& common) {
   ps::ColourSetting colour;
   colour.observer = ps::parse_observer(common.cmf, "--cmf");
   if (!common.bins.empty()) colour.bins = ps::BinLayout::parse(common.bins, "--bins");
+  describe(common, colour);
   return colour;
 }
 
@@ -169,6 +182,7 @@ int run_metamer(const MetamerCommand& cmd, const CommonOptions& common) {
   std::vector<double> values;
   for (const ps::NamedLight& l : lights)
     values.push_back(ps::delta_e2000_under(albedo, result.reflectance, l.spectrum, options.colour));
+  if (common.quiet) return ps::kExitOk;
   std::printf("metamer of %s written to %s (values %.3f..%.3f)\n", cmd.albedo.c_str(), cmd.output.c_str(),
               result.reflectance.min_value(), result.reflectance.max_value());
   print_table(lights, values, "dE00");
@@ -203,6 +217,7 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
       ps::design_light(a, b, cmd.hide ? ps::LightGoal::Hide : ps::LightGoal::Reveal, reference, primaries, options);
   ps::write_spectrum_csv(cmd.output, result.light, "relative_spd");
 
+  if (common.quiet) return ps::kExitOk;
   std::printf("%s light written to %s\n", cmd.hide ? "hiding" : "revealing", cmd.output.c_str());
   if (!primaries.empty()) {
     std::printf("mix:");
@@ -271,10 +286,17 @@ int main(int argc, char** argv) {
                program};
   app.set_version_flag("--version", ps::prizma_version());
   app.require_subcommand(1);
+  // Global options may come before or after the subcommand (prizma-metamer weights --bins … too).
+  app.fallthrough();
   CommonOptions common;
   app.add_option("--bins", common.bins,
                  "bins the colours are computed in, e.g. a render's 'linear:380:780:16' (default: 1 nm, 380-780 nm)");
   app.add_option("--cmf", common.cmf, "observer: 1931, 1964, 2012-2, 2012-10")->capture_default_str();
+  app.add_flag("-q,--quiet", common.quiet, "metamer, light: no summary or table on stdout (the CSV is written)");
+  app.add_flag("-v,--verbose", common.verbose, "print the observer, bins and data folder used");
+  app.add_option("--threads", common.threads,
+                 "worker threads (0 = all cores; accepted like the other tools: the designs run on one thread)")
+      ->check(CLI::NonNegativeNumber);
 
   MetamerCommand metamer;
   CLI::App* sub_metamer = app.add_subcommand(

@@ -21,17 +21,27 @@ std::filesystem::path data_dir() {
   if (const char* env = std::getenv("PRIZMA_DATA_DIR"); env != nullptr && *env != '\0') {
     return std::filesystem::path(env);
   }
-  // 2. The source tree's data/ recorded at build time (running from the build tree).
+  // 2. Installed layout, relative to the executable (<prefix>/bin/<exe> → <prefix>/share/prizma):
+  //    an installed tree works wherever it is moved, and does not depend on the source tree.
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  std::filesystem::path installed;
+  if (!ec && !exe.empty()) {
+#ifdef PRIZMA_INSTALL_DATA_RELATIVE
+    installed = (exe.parent_path() / PRIZMA_INSTALL_DATA_RELATIVE).lexically_normal();
+#else
+    installed = exe.parent_path().parent_path() / "share" / "prizma";
+#endif
+    if (is_dir(installed)) return installed;
+  }
+  // 3. The source tree's data/ recorded at build time (running from the build tree).
 #ifdef PRIZMA_SOURCE_DATA_DIR
   {
     const std::filesystem::path source_dir(PRIZMA_SOURCE_DATA_DIR);
     if (!source_dir.empty() && is_dir(source_dir)) return source_dir;
   }
 #endif
-  // 3. Installed layout: <prefix>/bin/<exe> → <prefix>/share/prizma.
-  std::error_code ec;
-  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec && !exe.empty()) return exe.parent_path().parent_path() / "share" / "prizma";
+  if (!installed.empty()) return installed;
   return std::filesystem::path("share") / "prizma";
 }
 

@@ -1,5 +1,6 @@
 // prizma-relight: relights a spectral EXR under any light spectra, in milliseconds, with no re-render.
 // Thin over prizma::relight: parse options, validate, run a single image, a batch or a session.
+#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <sstream>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,7 @@
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/data_path.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
 #include "prizma/spectral/stderr_capture.h"
 #include "prizma/spectral/tool_main.h"
 
@@ -44,7 +47,11 @@ struct CliOptions {
   bool absolute = false;
   std::string display = "sRGB";
   std::string colour_space;
+  std::string ocio;
   int bit_depth = 8;
+  bool display_given = false;  // --display on the command line (not the default)
+  int threads = 0;
+  bool quiet = false;
   std::string batch;
   bool interactive = false;
   std::string preview;
@@ -100,13 +107,14 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
   s.relight.units = o.absolute ? spectral::LightUnits::Absolute : spectral::LightUnits::RelativeToWhite;
   s.output.display.display = o.display;
   s.output.display.colour_space = o.colour_space;
+  if (!o.ocio.empty()) s.output.display.config = o.ocio;
   s.output.bit_depth = o.bit_depth;
   return s;
 }
 
 // session.save(), with what libpng prints on stderr (e.g. "libpng error: No IDATs written into
 // file" when memory runs out) made part of the one error line, and running out of memory named.
-void save_one_line(relight::RelightSession& session, const std::string& output) {
+void save_one_line(relight::RelightSession& session, const std::string& output, bool quiet) {
   spectral::StderrCapture capture;
   try {
     spectral::allocating("writing " + output, [&] { session.save(output); });
@@ -116,7 +124,23 @@ void save_one_line(relight::RelightSession& session, const std::string& output) 
     throw spectral::RuntimeError(std::string(e.what()) + spectral::library_said("libpng", capture.finish(), e.what()));
   }
   const std::string printed = capture.finish();
-  if (!printed.empty()) std::cerr << printed << "\n";  // warnings of a successful write
+  if (!printed.empty() && !quiet) std::cerr << printed << "\n";  // warnings of a successful write
+}
+
+// An option that nothing of this run would use is refused, not silently ignored: --display when
+// the only output is an EXR (linear: XYZ, or --colour-space), --colour-space when the only output
+// is a display-encoded PNG, TIFF or JPEG. With --batch, -i or --serve either may be used there.
+void check_options_used(const CliOptions& o) {
+  if (o.output.empty() || !o.batch.empty() || o.interactive || o.serve) return;
+  const bool exr = relight::output_format_for(o.output) == relight::OutputFormat::Exr;
+  if (exr && o.display_given && !o.show) {
+    throw InputError("--display", "an EXR output is linear, not display-encoded (XYZ, or --colour-space NAME): "
+                                  "--display applies to .png, .tif and .jpg outputs and --show");
+  }
+  if (!exr && !o.colour_space.empty()) {
+    throw InputError("--colour-space", "applies to EXR outputs only (linear); " + o.output +
+                                           " is display-encoded: choose its encoding with --display");
+  }
 }
 
 int run(const CliOptions& o) {
@@ -129,6 +153,8 @@ int run(const CliOptions& o) {
   // Cheap checks first: nothing is loaded when the output cannot be written.
   if (!o.output.empty()) relight::check_output_path(o.output, "--output");
   if (!o.preview.empty()) relight::check_output_path(o.preview, "--preview");
+  check_options_used(o);
+  if (!o.ocio.empty()) spectral::require_regular_file(o.ocio, "an OCIO config");
 
   relight::RelightSession session =
       spectral::allocating("reading " + o.input, [&] { return relight::RelightSession(o.input); });
@@ -170,7 +196,7 @@ int run(const CliOptions& o) {
   }
   if (!o.output.empty()) {
     const double ms = spectral::allocating("relighting", [&] { return session.relight(); });
-    save_one_line(session, o.output);
+    save_one_line(session, o.output, o.quiet);
     if (o.verbose) std::cerr << "prizma-relight: wrote " << o.output << " (relit in " << ms << " ms)\n";
   }
   if (o.show && !o.interactive) {
@@ -190,7 +216,7 @@ int run(const CliOptions& o) {
     so.port = o.port;
     so.save_dir = o.save_dir;
     relight::RelightServer server(session, so);
-    if (!relight::is_loopback_address(o.bind)) {
+    if (!relight::is_loopback_address(o.bind) && !o.quiet) {
       std::cerr << "prizma-relight: warning: --bind " << o.bind
                 << " is not a loopback address: every host that can reach it sees the page and can save files\n";
     }
@@ -215,7 +241,8 @@ int main(int argc, char** argv) {
   CliOptions o;
   app.add_option("input", o.input, "spectral EXR written by prizma-render (or any reflective spectral EXR)")
       ->required();
-  app.add_option("-o,--output", o.output, "output image: .png (8/16-bit), .tif, .exr (linear XYZ or --colour-space)");
+  app.add_option("-o,--output", o.output,
+                 "output image: .png (8/16-bit), .tif, .jpg (8-bit), .exr (linear XYZ or --colour-space)");
   app.add_option("--light", o.lights,
                  "NAME=SPEC for one light layer, or SPEC for every layer; SPEC: D65, A, F11, LED-B1, "
                  "blackbody:3200K, gaussian:550:20, box:500:560, csv:FILE, off, …*SCALE (repeatable)")
@@ -223,8 +250,11 @@ int main(int argc, char** argv) {
   app.add_option("--exposure", o.exposure_ev, "exposure in stops (EV)");
   app.add_option("--cmf", o.cmf, "colour matching functions: 1931, 1964, 2012-2, 2012-10")->capture_default_str();
   app.add_flag("--adapt", o.adapt, "Bradford chromatic adaptation from the light mix's white to D65");
-  app.add_option("--display", o.display, "OCIO display for PNG/TIFF")->capture_default_str();
-  app.add_option("--colour-space,--color-space", o.colour_space, "linear OCIO colour space for EXR output");
+  app.add_option("--display", o.display, "OCIO display for PNG/TIFF/JPEG (refused with only an EXR output)")
+      ->capture_default_str();
+  app.add_option("--colour-space,--color-space", o.colour_space,
+                 "linear OCIO colour space for EXR output (refused with only a PNG/TIFF/JPEG output)");
+  app.add_option("--ocio", o.ocio, "OpenColorIO config file (default: $OCIO, else Prizma's own)");
   app.add_flag("--absolute", o.absolute, "absolute light units (no normalisation to Y = 1 for white)");
   app.add_option("--bit-depth", o.bit_depth, "PNG/TIFF bit depth")->check(CLI::IsMember({8, 16}))->capture_default_str();
   app.add_option("--batch", o.batch, "JSON file listing outputs and their settings (docs/relight.md)");
@@ -232,12 +262,17 @@ int main(int argc, char** argv) {
   app.add_option("--preview", o.preview, "interactive: image rewritten after every change");
   app.add_flag("--show", o.show, "print a true-colour terminal thumbnail (with -i: draw the image at the start)");
   app.add_flag("--show-every", o.show_every, "interactive: draw the image after every change");
-  app.add_flag("--verbose", o.verbose, "echo data files, OCIO config and lights");
+  app.add_flag("-v,--verbose", o.verbose, "echo data files, OCIO config and lights");
+  app.add_flag("-q,--quiet", o.quiet, "print nothing but errors (no warnings)");
+  app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_flag("--serve", o.serve, "serve the live relighting page (prints its URL; Ctrl-C stops it)");
   app.add_option("--bind", o.bind, "--serve: address to listen on")->capture_default_str();
   app.add_option("--port", o.port, "--serve: port (0: a free one)")->check(CLI::Range(0, 65535))->capture_default_str();
   app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")->capture_default_str();
   app.set_version_flag("--version", prizma::spectral::prizma_version());
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  o.display_given = app.count("--display") > 0;
+  std::optional<tbb::global_control> threads;
+  if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
   return spectral::run_tool("prizma-relight", [&] { return run(o); });
 }

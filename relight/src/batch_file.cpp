@@ -22,17 +22,20 @@ using spectral::InputError;
 namespace {
 
 const std::set<std::string> kSettingKeys = {"lights", "exposure", "cmf",        "adapt",   "absolute",
-                                            "display", "view",    "colourSpace", "bitDepth"};
+                                            "display", "view",    "colourSpace", "colorSpace", "bitDepth"};
 
 // Applies the keys of one JSON object (an output or "defaults") onto settings. `where` names it.
 void apply_keys(const json& obj, const std::string& where, const RelightSession& session, const fs::path& base_dir,
                 RelightSettings& s) {
+  if (obj.is_object() && obj.contains("colourSpace") && obj.contains("colorSpace")) {
+    throw InputError(where + ".colorSpace", "give colourSpace or colorSpace (the same key), not both");
+  }
   for (const auto& [key, value] : obj.items()) {
     const std::string input = where + "." + key;
     if (key == "file") continue;
     if (!kSettingKeys.count(key)) {
       throw InputError(input, "unknown key (known: file, lights, exposure, cmf, adapt, absolute, display, view, "
-                              "colourSpace, bitDepth)");
+                              "colourSpace (or colorSpace), bitDepth)");
     }
     try {
       if (key == "lights") {
@@ -63,7 +66,7 @@ void apply_keys(const json& obj, const std::string& where, const RelightSession&
         s.output.display.display = value.get<std::string>();
       } else if (key == "view") {
         s.output.display.view = value.get<std::string>();
-      } else if (key == "colourSpace") {
+      } else if (key == "colourSpace" || key == "colorSpace") {
         s.output.display.colour_space = value.get<std::string>();
       } else if (key == "bitDepth") {
         // Exactly the integers 8 and 16: nlohmann would truncate 8.7 and wrap 4294967304 to 8.

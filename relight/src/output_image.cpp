@@ -21,7 +21,8 @@ OutputFormat output_format_for(const fs::path& path, const std::string& input) {
   if (ext == ".png") return OutputFormat::Png;
   if (ext == ".tif" || ext == ".tiff") return OutputFormat::Tiff;
   if (ext == ".exr") return OutputFormat::Exr;
-  throw InputError(input, "unknown output format \"" + path.string() + "\" (known: .png, .tif, .tiff, .exr)");
+  if (ext == ".jpg" || ext == ".jpeg") return OutputFormat::Jpeg;
+  throw InputError(input, "unknown output format \"" + path.string() + "\" (known: .png, .tif, .tiff, .jpg, .jpeg, .exr)");
 }
 
 void check_output_path(const fs::path& path, const std::string& input) {
@@ -42,6 +43,9 @@ spectral::DisplayOptions transform_options(OutputFormat format, const OutputOpti
 void check_output_options(OutputFormat format, const OutputOptions& opts) {
   if (opts.bit_depth != 8 && opts.bit_depth != 16) {
     throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(opts.bit_depth));
+  }
+  if (format == OutputFormat::Jpeg && opts.bit_depth != 8) {
+    throw InputError("--bit-depth", "JPEG is 8-bit only (got " + std::to_string(opts.bit_depth) + "; use .png or .tif for 16)");
   }
   if (needs_transform(format, opts)) spectral::DisplayTransform check(transform_options(format, opts));
 }
@@ -83,6 +87,7 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
     spec.channelnames = {"R", "G", "B"};
   }
   if (format == OutputFormat::Exr) spec.attribute("compression", "zip");
+  if (format == OutputFormat::Jpeg) spec.attribute("Compression", "jpeg:95");
   for (const auto& [key, value] : metadata) spec.attribute(key, value);
 
   spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {

@@ -75,6 +75,7 @@ struct Options {
   bool half = false;
   std::string preview;
   std::string resume;
+  std::vector<std::string> defines;  // -D KEY=VALUE, in order
   bool quiet = false;
   bool verbose = false;
 };
@@ -146,18 +147,27 @@ int merge_main(int argc, char** argv) {
   app.set_version_flag("--version", spectral::prizma_version());
   std::vector<std::string> inputs;
   std::string output, preview;
-  bool half = false, quiet = false, strict = false;
+  bool half = false, quiet = false, verbose = false, strict = false;
+  int threads = 0;
   app.add_option("shards", inputs, "shard files (spectral EXR written by prizma-render)")->required();
   app.add_option("-o,--output", output, "merged output file")->required();
   app.add_option("--preview", preview, "also write an sRGB preview (PNG) under the lights' default spectra");
   app.add_flag("--half", half, "write half floats");
   app.add_flag("--strict", strict, "refuse shards that leave a gap in the sample range (exit 2)");
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
+  app.add_flag("-v,--verbose", verbose, "name each shard and its samples as it is read");
+  app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   if (const int rc = spectral::parse_command_line(app, argc - 1, argv + 1); rc >= 0) return rc;
+  std::optional<tbb::global_control> thread_limit;
+  if (threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
   return spectral::run_tool(kProgram, [&] {
     check_outputs(output, "-o", preview);
     std::vector<spectral::SpectralImage> shards;
-    for (const auto& f : inputs) shards.push_back(spectral::read_spectral_exr(f));
+    for (const auto& f : inputs) {
+      shards.push_back(spectral::read_spectral_exr(f));
+      if (verbose)
+        std::cerr << kProgram << ": shard " << f << ": samples " << shards.back().info.sample_range << "\n";
+    }
     const auto merged = render::merge_shards(shards, inputs);
     if (merged.info.sample_range.find(',') != std::string::npos) {
       // The union has gaps: a valid render of fewer samples, but most likely a shard is missing.
@@ -212,6 +222,11 @@ int main(int argc, char** argv) {
   app.add_option("--resume", o.resume,
                  "continue a partial (interrupted) render from the scene and options it records, up to "
                  "its target or --spp N in all, and merge (output defaults to this file)");
+  app.add_option("-D", o.defines,
+                 "KEY=VALUE: set any scene field by its path, e.g. -D camera.fov_deg=30, "
+                 "-D lights.side.spectrum=A, -D materials[1].albedo=0.5 (repeatable; checked like the file)")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
   app.add_flag("-q,--quiet", o.quiet, "no progress bar or summary");
   app.add_flag("-v,--verbose", o.verbose, "print the scene, mode and statistics");
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
@@ -239,7 +254,11 @@ int main(int argc, char** argv) {
     render::Scene scene;
     render::RenderOverrides recorded;  // what the output will record in prizma:renderOptions
     std::optional<spectral::SpectralImage> previous;
+    std::vector<render::SceneOverride> defines;
+    for (const std::string& d : o.defines) defines.push_back(render::parse_scene_override(d));
     if (!o.resume.empty()) {
+      if (!defines.empty())
+        throw InputError("-D", "not with --resume (the partial file's scene is continued as it was rendered)");
       render::ResumeRequest req{o.resume, o.scene, given, o.spp};
       render::ResumePlan plan = render::plan_resume(req);
       std::error_code ec;
@@ -261,7 +280,7 @@ int main(int argc, char** argv) {
       previous = std::move(plan.previous);
     } else {
       if (o.scene.empty()) throw InputError("scene", "no scene file given (or --resume a partial render)");
-      scene = spectral::allocating("reading the scene and its volume", [&] { return render::load_scene(o.scene); });
+      scene = spectral::allocating("reading the scene and its volume", [&] { return render::load_scene(o.scene, defines); });
       render::apply_overrides(scene, given);
       auto& st = scene.settings;
       if (given.samples) std::tie(st.sample_begin, st.sample_end) = std::pair(given.samples->begin, given.samples->end);

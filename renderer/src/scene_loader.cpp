@@ -48,12 +48,19 @@ std::string num(double v) {
 // Reading JSON with a field path for every message.
 class Reader {
  public:
-  Reader(std::string file, std::filesystem::path base_dir) : m_file(std::move(file)), m_base(std::move(base_dir)) {}
+  Reader(std::string file, std::filesystem::path base_dir, std::vector<std::string> overridden = {})
+      : m_file(std::move(file)), m_base(std::move(base_dir)), m_overridden(std::move(overridden)) {}
 
   const std::string& file() const { return m_file; }
   const std::filesystem::path& base_dir() const { return m_base; }
   std::string input(const std::string& path) const {
     if (m_file.empty()) return path;  // a command-line option
+    // A field set (or inside a value set) by -D KEY=VALUE is named as the option that set it.
+    for (const std::string& o : m_overridden) {
+      if (path == o || (path.size() > o.size() && path.compare(0, o.size(), o) == 0 &&
+                        (path[o.size()] == '.' || path[o.size()] == '[')))
+        return "-D " + path;
+    }
     return path.empty() ? m_file : m_file + ": " + path;
   }
 
@@ -150,6 +157,7 @@ class Reader {
  private:
   std::string m_file;
   std::filesystem::path m_base;
+  std::vector<std::string> m_overridden;  // field paths set by -D, as this reader names them
 };
 
 // 64-bit FNV-1a.
@@ -258,9 +266,10 @@ Interpolation read_interpolation(const Reader& rd, const json& j) {
 }
 
 ValueNormalisation read_normalisation(const Reader& rd, const json& root, const Volume& vol) {
-  if (!root.contains("normalisation")) return auto_normalisation(vol);
-  const json& j = root.at("normalisation");
-  const std::string path = "normalisation";
+  // Both spellings; load_scene refuses a file that has both.
+  const std::string path = root.contains("normalization") ? "normalization" : "normalisation";
+  if (!root.contains(path)) return auto_normalisation(vol);
+  const json& j = root.at(path);
   if (j.is_string()) {
     if (j.get<std::string>() != "auto") rd.fail(path, "must be \"auto\" or {\"min\": number, \"max\": number} (got " + j.dump() + ")");
     return auto_normalisation(vol);
@@ -639,7 +648,112 @@ json override_json(const std::string& text, const std::string& option, const cha
   return j;
 }
 
+// One "-D KEY=VALUE" applied to the scene's JSON before it is validated. KEY is a field path:
+// object keys separated by '.', array elements by index ("lights[1]", "lights.1") or, in arrays of
+// named objects (lights, materials), by name ("lights.side"). VALUE is typed by the field it
+// replaces: text for a string field, JSON (a number, true, [0, 1, 0], …) otherwise; text that is
+// not JSON stays a string, which the scene's own checks then refuse where a number is needed.
+// Returns the field's path as the scene reader names it ("lights[0].spectrum").
+std::string apply_scene_override(json& root, const SceneOverride& o) {
+  const std::string option = "-D " + o.key;
+  // Split into segments: "a.b[2].c" → a, b, 2, c.
+  const std::string& key = o.key;
+  const auto malformed = [&] {
+    throw InputError(option, "malformed key (fields separated by '.', elements by index or name: camera.fov_deg, "
+                             "lights[0].spectrum, lights.side.spectrum)");
+  };
+  std::vector<std::string> segments;
+  for (std::size_t i = 0; i < key.size();) {
+    if (key[i] == '[') {
+      const std::size_t close = key.find(']', i);
+      if (close == std::string::npos || close == i + 1) malformed();
+      segments.push_back(key.substr(i + 1, close - i - 1));
+      i = close + 1;
+    } else {
+      std::size_t end = key.find_first_of(".[", i);
+      if (end == std::string::npos) end = key.size();
+      if (end == i) malformed();
+      segments.push_back(key.substr(i, end - i));
+      i = end;
+    }
+    if (i < key.size()) {
+      if (key[i] == '.') {
+        if (++i == key.size()) malformed();
+      } else if (key[i] != '[') {
+        malformed();
+      }
+    }
+  }
+  if (segments.empty()) throw InputError("-D", "empty key (expected -D key=value, e.g. -D camera.fov_deg=30)");
+
+  json* node = &root;
+  std::string path;  // as Reader names it
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    const std::string& seg = segments[k];
+    const bool last = k + 1 == segments.size();
+    json* next = nullptr;
+    if (node->is_array()) {
+      std::size_t index = node->size();
+      const bool numeric = !seg.empty() && seg.size() <= 9 && std::all_of(seg.begin(), seg.end(), [](char ch) {
+        return ch >= '0' && ch <= '9';
+      });
+      if (numeric) {
+        index = static_cast<std::size_t>(std::stoul(seg));
+      } else {
+        for (std::size_t i = 0; i < node->size(); ++i) {
+          const json& e = (*node)[i];
+          if (e.is_object() && e.contains("name") && e.at("name").is_string() && e.at("name").get<std::string>() == seg) {
+            index = i;
+            break;
+          }
+        }
+      }
+      if (index >= node->size()) {
+        std::string names;
+        for (const json& e : *node)
+          if (e.is_object() && e.contains("name") && e.at("name").is_string())
+            names += (names.empty() ? "" : ", ") + e.at("name").get<std::string>();
+        throw InputError(option, (path.empty() ? std::string("the scene") : path) + " has no element " +
+                                     (numeric ? seg : "named \"" + seg + "\"") + " (" +
+                                     std::to_string(node->size()) + " elements" +
+                                     (names.empty() ? std::string() : ": " + names) + ")");
+      }
+      path = Reader::index(path, index);
+      next = &(*node)[index];
+    } else {
+      if (node->is_null()) *node = json::object();  // a section the scene leaves out: "-D camera.fov_deg=30"
+      if (!node->is_object())
+        throw InputError(option, path + " is " + std::string(node->type_name()) + ", not an object with fields");
+      path = Reader::join(path, seg);
+      next = &(*node)[seg];  // created (null) when absent
+    }
+    if (last) {
+      json value;
+      const bool string_field = next->is_string();
+      if (!string_field) {
+        spectral::check_json_depth(o.value, option);
+        value = json::parse(o.value, nullptr, /*allow_exceptions=*/false);
+      }
+      if (string_field || value.is_discarded()) {
+        // A JSON string literal ("\"D65\"") is taken as its text, other text as it is.
+        const json quoted = json::parse(o.value, nullptr, false);
+        value = !quoted.is_discarded() && quoted.is_string() ? quoted : json(o.value);
+      }
+      *next = std::move(value);
+    }
+    node = next;
+  }
+  return path;
+}
+
 }  // namespace
+
+SceneOverride parse_scene_override(const std::string& text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("-D " + text, "expected KEY=VALUE, e.g. -D camera.fov_deg=30 (KEY a field path of the scene)");
+  return SceneOverride{text.substr(0, eq), text.substr(eq + 1)};
+}
 
 std::int64_t scene_integer_override(const std::string& text, const std::string& field, const std::string& option) {
   const auto [lo, hi] = integer_field_range(field);
@@ -652,7 +766,7 @@ std::uint64_t scene_seed_override(const std::string& text, const std::string& op
   return read_seed(Reader("", {}), j, option);
 }
 
-Scene load_scene(const std::filesystem::path& path) {
+Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverride>& overrides) {
   const std::string file = path.string();
   spectral::require_regular_file(path, "a scene file");
   std::ifstream in(path, std::ios::binary);
@@ -661,10 +775,20 @@ Scene load_scene(const std::filesystem::path& path) {
   buffer << in.rdbuf();
   const std::string text = buffer.str();
 
-  const json root = parse_json(text, file);
-  const Reader rd(file, path.parent_path());
+  json root = parse_json(text, file);
+  std::vector<std::string> overridden;
+  if (!overrides.empty() && !root.is_object()) throw InputError(file, "must be an object (the scene) for -D");
+  for (const SceneOverride& o : overrides) {
+    const std::string field = apply_scene_override(root, o);
+    if (std::find(overridden.begin(), overridden.end(), field) != overridden.end())
+      throw InputError("-D " + o.key, "is given twice");
+    overridden.push_back(field);
+  }
+  const Reader rd(file, path.parent_path(), overridden);
+  if (root.contains("normalisation") && root.contains("normalization"))
+    rd.fail("normalization", "give normalisation or normalization (the same field), not both");
   rd.expect_object(root, "",
-                   {"description", "volume", "normalisation", "materials", "transfer_function", "camera", "lights",
+                   {"description", "volume", "normalisation", "normalization", "materials", "transfer_function", "camera", "lights",
                     "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "target_error", "output",
                     "emission_light"});
   if (root.contains("description")) rd.string(root.at("description"), "description");
@@ -718,6 +842,10 @@ Scene load_scene(const std::filesystem::path& path) {
   // Hash: scene text, volume values, the materials' spectra (which csv files or images may supply).
   Fnv1a h;
   h.add(text.data(), text.size());
+  for (const SceneOverride& o : overrides) {  // a render with -D is not the file's render (--resume checks)
+    const std::string d = "\n-D " + o.key + "=" + o.value;
+    h.add(d.data(), d.size());
+  }
   h.add(vol.dims.data(), sizeof vol.dims);
   h.add(vol.spacing.data(), sizeof vol.spacing);
   h.add(vol.values.data(), vol.values.size() * sizeof(float));

@@ -544,5 +544,43 @@ TEST(SceneLoader, CommandLineOverridesObeyTheSceneRanges) {
             std::string::npos);
 }
 
+// -D KEY=VALUE (prizma-render): a field set by its path, typed by the field it replaces, checked as
+// the file is, errors named by the option; the overrides change the scene's hash.
+TEST(SceneLoader, DefineOverridesAnyFieldByItsPath) {
+  ScratchDir dir;
+  const auto path = write_scene(dir, base_scene());
+  const Scene plain = load_scene(path);
+  const Scene s = load_scene(path, {parse_scene_override("camera.fov_deg=30"), parse_scene_override("lights.sky.spectrum=A"),
+                                    parse_scene_override("lights[0].direction=[0, 1, 0]"),
+                                    parse_scene_override("bins=linear:400:700:4"), parse_scene_override("seed=9"),
+                                    parse_scene_override("normalization={\"min\": 0, \"max\": 255}")});
+  EXPECT_DOUBLE_EQ(s.camera.fov_y_deg, 30.0);
+  EXPECT_EQ(s.lights[1].spectrum_spec, "A");
+  EXPECT_TRUE(s.lights[0].direction.isApprox(Eigen::Vector3d(0, 1, 0)));
+  EXPECT_EQ(s.settings.bins, spectral::BinLayout::linear(400, 700, 4));
+  EXPECT_EQ(s.settings.seed, 9u);
+  EXPECT_NE(s.hash, plain.hash);
+  EXPECT_EQ(load_scene(path, {parse_scene_override("seed=9")}).hash, load_scene(path, {parse_scene_override("seed=9")}).hash);
+  auto error = [&](const std::vector<std::string>& defines) {
+    try {
+      std::vector<SceneOverride> o;
+      for (const auto& d : defines) o.push_back(parse_scene_override(d));
+      load_scene(path, o);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error({"camera.fov_deg=300"}), "-D camera.fov_deg: must be in (0, 180) (got 300)");
+  EXPECT_EQ(error({"samples=many"}), "-D samples: must be an integer (got string \"many\")");
+  EXPECT_EQ(error({"lights.fill.spectrum=A"}), "-D lights.fill.spectrum: lights has no element named \"fill\" (2 elements: side, sky)");
+  EXPECT_EQ(error({"seed=1", "seed=2"}), "-D seed: is given twice");
+  EXPECT_EQ(error({"lights[0].spectrum=A", "lights.side.spectrum=A"}), "-D lights.side.spectrum: is given twice");
+  EXPECT_EQ(error({"camera..width=3"}).rfind("-D camera..width: malformed key", 0), 0u);
+  EXPECT_EQ(error({"seed"}).rfind("-D seed: expected KEY=VALUE", 0), 0u);
+  EXPECT_EQ(error({"normalization=\"auto\"", "normalisation=\"auto\""}),
+            "-D normalization: give normalisation or normalization (the same field), not both");
+}
+
 }  // namespace
 }  // namespace prizma::render

@@ -1,6 +1,7 @@
 #pragma once
-// Where Prizma finds data/ (CIE tables, OCIO config): $PRIZMA_DATA_DIR if set, else the source
-// tree's data/ recorded at build time, else <executable>/../share/prizma.
+// Where Prizma finds data/ (CIE tables, OCIO config): $PRIZMA_DATA_DIR if set, else the installed
+// data next to the executable (<executable>/../share/prizma, when that folder exists), else the
+// source tree's data/ recorded at build time (running from the build tree).
 #include <filesystem>
 
 namespace prizma::spectral {

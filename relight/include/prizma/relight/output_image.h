@@ -2,6 +2,7 @@
 // Writing a relit image: display transform (OpenColorIO) then OpenImageIO by extension, atomically.
 //   .png          display-encoded, 8-bit (default) or 16-bit
 //   .tif / .tiff  display-encoded, 8-bit or 16-bit
+//   .jpg / .jpeg  display-encoded, 8-bit (quality 95)
 //   .exr          linear float, no display transform: XYZ (channels X, Y, Z), or a linear colour
 //                 space of the OCIO config (channels R, G, B) when colour_space is set
 #include <filesystem>
@@ -14,7 +15,7 @@
 
 namespace prizma::relight {
 
-enum class OutputFormat { Png, Tiff, Exr };
+enum class OutputFormat { Png, Tiff, Exr, Jpeg };
 
 // Format from the extension (case-insensitive). Throws InputError (input `input`) for others.
 OutputFormat output_format_for(const std::filesystem::path& path, const std::string& input = "--output");
@@ -35,7 +36,7 @@ void check_output_path(const std::filesystem::path& path, const std::string& inp
 // integer outputs by the caller. Non-finite values become 0.
 std::vector<float> to_display(const XyzImage& image, const spectral::DisplayTransform& display);
 
-// The display options a format uses: PNG/TIFF the display (colour_space cleared); EXR the linear
+// The display options a format uses: PNG/TIFF/JPEG the display (colour_space cleared); EXR the linear
 // colour space, or none (XYZ written as is) when colour_space is empty.
 bool needs_transform(OutputFormat format, const OutputOptions& opts);
 spectral::DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts);

@@ -103,9 +103,19 @@ struct Scene {
   std::filesystem::path source;  // the scene file
 };
 
+// A command-line override of one scene field (prizma-render -D KEY=VALUE).
+struct SceneOverride {
+  std::string key;    // field path: "camera.fov_deg", "lights.side.spectrum", "materials[1].albedo"
+  std::string value;  // text: a string field takes it as it is, other fields as JSON
+};
+// "camera.fov_deg=30" → {key, value}; InputError (input "-D TEXT") without '=' or with no key.
+SceneOverride parse_scene_override(const std::string& text);
+
 // Reads and validates a scene file. Errors are InputError with input "<file>: <field path>", e.g.
 // "scene.json: materials[1].extinction.scale: must be > 0". Paths are relative to the scene file.
-Scene load_scene(const std::filesystem::path& path);
+// `overrides` are applied to the file's JSON first, then validated by the same checks; an error in
+// an overridden field names it as "-D <field path>". They are part of the scene's hash.
+Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverride>& overrides = {});
 
 // A command-line value for an integer scene field ("camera.width", "camera.height", "samples",
 // "seed", "max_bounces"), checked exactly as load_scene checks the field (same type, same range).

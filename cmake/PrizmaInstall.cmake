@@ -1,0 +1,37 @@
+# install(): `cmake --install build --prefix X` gives a working tree, relocatable as a whole:
+#   X/bin/prizma-render, prizma-relight, prizma-metamer
+#   X/share/prizma/{spectra,ocio,scenes}   the data the tools read (found relative to the executable)
+#   X/share/doc/prizma/                    README.md and docs/ (the user guide runs against this tree)
+include(GNUInstallDirs)
+
+set(PRIZMA_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/prizma" CACHE STRING
+    "Where the data tables, OCIO config and example scenes go, relative to the prefix")
+# The executables find the data from their own location, so the tree works wherever it is moved
+# ($PRIZMA_DATA_DIR still overrides): the path from bin/ to the data folder, compiled in.
+if(IS_ABSOLUTE "${CMAKE_INSTALL_BINDIR}" OR IS_ABSOLUTE "${PRIZMA_INSTALL_DATADIR}")
+  file(RELATIVE_PATH _prizma_data_rel "${CMAKE_INSTALL_FULL_BINDIR}" "${CMAKE_INSTALL_PREFIX}/${PRIZMA_INSTALL_DATADIR}")
+else()
+  file(RELATIVE_PATH _prizma_data_rel "/prefix/${CMAKE_INSTALL_BINDIR}" "/prefix/${PRIZMA_INSTALL_DATADIR}")
+endif()
+target_compile_definitions(prizma_spectral PRIVATE PRIZMA_INSTALL_DATA_RELATIVE="${_prizma_data_rel}")
+
+set(_prizma_tools)
+foreach(tool prizma-render prizma-relight prizma-metamer)
+  if(TARGET ${tool})
+    list(APPEND _prizma_tools ${tool})
+  endif()
+endforeach()
+install(TARGETS ${_prizma_tools} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT tools)
+# Everything that is installed, and nothing else (no test suites): scripts/install and scripts/demo
+# build this target. A new installed target (the Python module) adds itself with add_dependencies.
+add_custom_target(prizma-installed)
+add_dependencies(prizma-installed ${_prizma_tools})
+
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/spectra ${PROJECT_SOURCE_DIR}/data/ocio ${PROJECT_SOURCE_DIR}/data/scenes
+        DESTINATION ${PRIZMA_INSTALL_DATADIR} COMPONENT data)
+
+install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT docs)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT docs)
+
+# The Python module (`import prizma`): its own CMakeLists has its install() rule (COMPONENT python)
+# and add_dependencies(prizma-installed <module>); scripts/install then builds and installs it too.
