@@ -2,6 +2,7 @@
 // the constructor; apply() only runs the processor, which OCIO documents as thread-safe.
 #include "prizma/spectral/display.h"
 
+#include <Eigen/LU>
 #include <OpenColorIO/OpenColorIO.h>
 
 #include <algorithm>
@@ -255,6 +256,60 @@ DisplayShader DisplayTransform::gpu_shader(const std::string& function_name) con
     throw RuntimeError(std::string("OCIO GPU shader: ") + e.what());
   }
   return out;
+}
+
+std::optional<DisplayMatrixCurve> DisplayTransform::split_matrix_curve() const {
+  try {
+    const OCIO::ConstGroupTransformRcPtr group = m_impl->processor->createGroupTransform();
+    Eigen::Matrix3d matrix = Eigen::Matrix3d::Identity();
+    OCIO::GroupTransformRcPtr tail = OCIO::GroupTransform::Create();
+    bool in_tail = false;
+    for (int i = 0; i < group->getNumTransforms(); ++i) {
+      const OCIO::ConstTransformRcPtr t = group->getTransform(i);
+      const OCIO::TransformType type = t->getTransformType();
+      if (type == OCIO::TRANSFORM_TYPE_MATRIX && !in_tail) {
+        const auto m = OCIO::DynamicPtrCast<const OCIO::MatrixTransform>(t);
+        double m44[16], offset[4];
+        m->getMatrix(m44);
+        m->getOffset(offset);
+        if (offset[0] != 0.0 || offset[1] != 0.0 || offset[2] != 0.0) return std::nullopt;
+        Eigen::Matrix3d step;
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) step(r, c) = m44[4 * r + c];
+        if (m->getDirection() == OCIO::TRANSFORM_DIR_INVERSE) step = step.inverse().eval();
+        matrix = step * matrix;
+        continue;
+      }
+      switch (type) {
+        case OCIO::TRANSFORM_TYPE_EXPONENT:
+        case OCIO::TRANSFORM_TYPE_EXPONENT_WITH_LINEAR:
+        case OCIO::TRANSFORM_TYPE_LOG:
+        case OCIO::TRANSFORM_TYPE_LOG_AFFINE:
+        case OCIO::TRANSFORM_TYPE_LOG_CAMERA:
+        case OCIO::TRANSFORM_TYPE_RANGE:
+          break;
+        case OCIO::TRANSFORM_TYPE_LUT1D:
+          if (OCIO::DynamicPtrCast<const OCIO::Lut1DTransform>(t)->getHueAdjust() != OCIO::HUE_NONE) return std::nullopt;
+          break;
+        default:
+          return std::nullopt;
+      }
+      in_tail = true;
+      tail->appendTransform(t->createEditableCopy());
+    }
+    const OCIO::ConstCPUProcessorRcPtr cpu = m_impl->config->getProcessor(tail)->getOptimizedCPUProcessor(
+        OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32, OCIO::OPTIMIZATION_LOSSLESS);
+    DisplayMatrixCurve out;
+    out.matrix = matrix;
+    out.curve = [cpu](float* rgb, std::size_t pixels) {
+      if (pixels == 0) return;
+      OCIO::PackedImageDesc desc(rgb, static_cast<long>(pixels), 1, 3);
+      cpu->apply(desc);
+    };
+    return out;
+  } catch (const OCIO::Exception&) {
+    return std::nullopt;
+  }
 }
 
 }  // namespace prizma::spectral

@@ -2,8 +2,11 @@
 // Display transforms through OpenColorIO: from CIE XYZ (the relighter's output, D65-relative white
 // at Y = 1) to a display or a linear working space. The processor is built once and applied to
 // whole images.
+#include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +44,14 @@ struct DisplayShader {
   std::vector<Texture> textures;
 };
 
+// A display transform split as XYZ → linear RGB by a 3×3 matrix, then a per-channel curve (the same
+// OCIO ops, in order): what lets a relighter fold the matrix into its own and bake the curve.
+struct DisplayMatrixCurve {
+  Eigen::Matrix3d matrix;
+  // The per-channel tail of the transform, in place on interleaved RGB. Thread-safe.
+  std::function<void(float*, std::size_t)> curve;
+};
+
 class DisplayTransform {
  public:
   // Throws InputError naming the config, display or colour space when it does not exist (listing the
@@ -62,6 +73,9 @@ class DisplayTransform {
   // The same transform (lossless optimisation) as OCIO's GLSL ES 3.0 code. Throws RuntimeError when
   // OCIO cannot generate it.
   DisplayShader gpu_shader(const std::string& function_name = "OCIODisplay") const;
+  // The transform as matrix + per-channel curve when its ops are leading offset-free matrices
+  // followed only by per-channel ops (exponents, logs, ranges, 1D LUTs); nullopt otherwise.
+  std::optional<DisplayMatrixCurve> split_matrix_curve() const;
 
  private:
   struct Impl;

@@ -1,0 +1,71 @@
+#pragma once
+// Compressed transport (docs/relight.md, "Compressed transport"): each light layer as k spectral
+// basis coefficients per pixel (libspectral's spectral_basis.h), relit with a 3×k matrix per light,
+// W_l = M_l·B_l, instead of 3×n; and DisplayEncoder8, the XYZ → 8-bit display step with the OCIO
+// transform's matrix applied directly and its per-channel curve baked into exact code thresholds.
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "prizma/relight/relight_matrix.h"
+#include "prizma/relight/xyz_image.h"
+#include "prizma/spectral/display.h"
+#include "prizma/spectral/spectral_basis.h"
+#include "prizma/spectral/spectral_exr.h"
+
+namespace prizma::relight {
+
+struct CompressedLayer {
+  std::string name;
+  int k = 0;
+  Eigen::MatrixXf basis;                     // n×k, orthonormal columns
+  std::vector<float> coefficients;           // pixels·k, pixel-major: c(p, j) = coefficients[p·k + j]
+  std::vector<spectral::BasisError> errors;  // at k, under the criterion's lights (empty if unknown)
+};
+
+struct CompressedTransport {
+  int width = 0;
+  int height = 0;
+  spectral::BinLayout bins;
+  std::vector<CompressedLayer> lights;
+  std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
+};
+
+// Per light: basis from the layer's Gram matrix, k by choose_basis_size, coefficients by projection.
+CompressedTransport compress_transport(const spectral::SpectralImage& image,
+                                       const spectral::BasisCriterion& criterion = {});
+
+// XYZ = Σ_l (M_l·B_l)·c_l for every pixel (TBB over rows; independent of the thread count). Throws
+// RuntimeError when the matrix does not match the transport's lights or bins, or a layer's sizes
+// are inconsistent.
+void relight_compressed_into(const CompressedTransport& transport, const RelightMatrix& matrix, float* xyz_out);
+XyzImage relight_compressed(const CompressedTransport& transport, const RelightMatrix& matrix);
+
+// XYZ → 8-bit display RGB, the values write_output_image writes into an 8-bit PNG (OCIO transform,
+// clamp to [0, 1], round to 255ths), computed fast when the transform is a matrix followed by a
+// per-channel curve (DisplayTransform::split_matrix_curve): the curve is baked into the 255 exact
+// linear thresholds between codes per channel, found by bisection on the curve itself, with a
+// 32768-entry table per channel indexed by a float's top 16 bits for a first guess. The baked form
+// is checked against the full transform on 4096 colours at construction; where the split does not
+// exist or the check fails, encode() runs the OCIO transform itself.
+class DisplayEncoder8 {
+ public:
+  explicit DisplayEncoder8(const spectral::DisplayTransform& display);
+  bool baked() const { return m_baked; }
+  // xyz: 3·pixels floats, interleaved; rgb: 3·pixels bytes. Non-finite values count as 0.
+  void encode(const float* xyz, std::size_t pixels, std::uint8_t* rgb) const;
+
+ private:
+  void encode_chunk(const float* xyz, std::size_t pixels, std::uint8_t* rgb) const;
+  const spectral::DisplayTransform* m_display;
+  bool m_baked = false;
+  Eigen::Matrix3f m_matrix = Eigen::Matrix3f::Identity();
+  // Per channel: m_thresholds[c][j] = smallest linear value with code ≥ j (j = 1..255; [0] unused).
+  std::array<std::array<float, 256>, 3> m_thresholds{};
+  std::array<std::vector<std::uint8_t>, 3> m_guess;  // code of the smallest value of each 16-bit bucket
+};
+
+}  // namespace prizma::relight

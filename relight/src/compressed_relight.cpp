@@ -1,0 +1,288 @@
+// Compressed transport and the baked 8-bit display encoder (compressed_relight.h).
+#include "prizma/relight/compressed_relight.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "prizma/spectral/error.h"
+
+namespace prizma::relight {
+
+namespace {
+
+// One light's 3×k weights (row-major) and its coefficients.
+struct CoeffTerm {
+  const float* weights;
+  const float* coefficients;
+  int k;
+};
+
+// Adds Σ_j W[:, j]·c(p, j) for a row of pixels into out (3 floats per pixel). K > 0 fixes k.
+template <int K>
+void add_row(const CoeffTerm& term, std::size_t first_pixel, int width, float* out) {
+  const int k = K > 0 ? K : term.k;
+  const float* w = term.weights;
+  const float* c = term.coefficients + first_pixel * static_cast<std::size_t>(k);
+  for (int x = 0; x < width; ++x, c += k) {
+    float X = 0.0f, Y = 0.0f, Z = 0.0f;
+    for (int j = 0; j < k; ++j) {
+      X += w[j] * c[j];
+      Y += w[k + j] * c[j];
+      Z += w[2 * k + j] * c[j];
+    }
+    out[3 * x + 0] += X;
+    out[3 * x + 1] += Y;
+    out[3 * x + 2] += Z;
+  }
+}
+
+using AddRow = void (*)(const CoeffTerm&, std::size_t, int, float*);
+
+AddRow add_row_for(int k) {
+  switch (k) {
+    case 1: return &add_row<1>;
+    case 2: return &add_row<2>;
+    case 3: return &add_row<3>;
+    case 4: return &add_row<4>;
+    case 5: return &add_row<5>;
+    case 6: return &add_row<6>;
+    case 7: return &add_row<7>;
+    case 8: return &add_row<8>;
+    case 10: return &add_row<10>;
+    case 12: return &add_row<12>;
+    case 16: return &add_row<16>;
+    default: return &add_row<0>;
+  }
+}
+
+std::uint8_t quantise(float v) {
+  // What OpenImageIO does converting float to uint8: clamp, scale, round half up.
+  const float c = std::clamp(v, 0.0f, 1.0f);
+  return static_cast<std::uint8_t>(std::floor(c * 255.0f + 0.5f));
+}
+
+}  // namespace
+
+CompressedTransport compress_transport(const spectral::SpectralImage& image, const spectral::BasisCriterion& criterion) {
+  CompressedTransport out;
+  out.width = image.width;
+  out.height = image.height;
+  out.bins = image.bins;
+  const int n = image.bins.size();
+  const std::size_t pixels = image.pixel_count();
+  for (const spectral::TransportLayer& layer : image.lights) {
+    if (layer.data.size() != pixels * static_cast<std::size_t>(n)) {
+      throw spectral::RuntimeError("compress: layer " + layer.name + " has " + std::to_string(layer.data.size()) +
+                                   " values, expected " + std::to_string(pixels * static_cast<std::size_t>(n)));
+    }
+    const spectral::SpectralBasis basis = spectral::spectral_basis(layer.data.data(), pixels, n);
+    const spectral::BasisChoice choice =
+        spectral::choose_basis_size(basis, layer.data.data(), pixels, image.bins, criterion);
+    CompressedLayer c;
+    c.name = layer.name;
+    c.k = choice.k;
+    c.basis = spectral::basis_columns(basis, choice.k);
+    c.coefficients = spectral::project_coefficients(basis, choice.k, layer.data.data(), pixels);
+    c.errors = choice.errors;
+    out.lights.push_back(std::move(c));
+  }
+  return out;
+}
+
+void relight_compressed_into(const CompressedTransport& transport, const RelightMatrix& matrix, float* xyz_out) {
+  const int n = transport.bins.size();
+  const int layers = static_cast<int>(transport.lights.size());
+  if (matrix.light_count() != layers || matrix.bin_count() != n) {
+    throw spectral::RuntimeError("relight: matrix is " + std::to_string(matrix.light_count()) + " lights × " +
+                                 std::to_string(matrix.bin_count()) + " bins, compressed transport has " +
+                                 std::to_string(layers) + " × " + std::to_string(n));
+  }
+  const std::size_t pixels = transport.pixel_count();
+  // W_l = M_l·B_l once per light setting, float, row-major; "off" lights are skipped.
+  std::vector<std::vector<float>> weights;
+  std::vector<CoeffTerm> terms;
+  std::vector<AddRow> kernels;
+  for (int l = 0; l < layers; ++l) {
+    const CompressedLayer& layer = transport.lights[static_cast<std::size_t>(l)];
+    if (layer.k < 1 || layer.basis.rows() != n || layer.basis.cols() != layer.k ||
+        layer.coefficients.size() != pixels * static_cast<std::size_t>(layer.k)) {
+      throw spectral::RuntimeError("relight: compressed layer " + layer.name + " has inconsistent sizes");
+    }
+    const Matrix3Xd& m = matrix.light(l);
+    if (m.isZero(0.0)) continue;
+    const Eigen::Matrix<double, 3, Eigen::Dynamic> w = m * layer.basis.cast<double>();
+    std::vector<float> row_major(3 * static_cast<std::size_t>(layer.k));
+    for (int c = 0; c < 3; ++c)
+      for (int j = 0; j < layer.k; ++j) row_major[static_cast<std::size_t>(c * layer.k + j)] = static_cast<float>(w(c, j));
+    weights.push_back(std::move(row_major));
+    terms.push_back({weights.back().data(), layer.coefficients.data(), layer.k});
+    kernels.push_back(add_row_for(layer.k));
+  }
+  const int width = transport.width;
+  tbb::parallel_for(tbb::blocked_range<int>(0, transport.height), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
+      float* out = xyz_out + 3 * first;
+      std::fill(out, out + 3 * static_cast<std::size_t>(width), 0.0f);
+      for (std::size_t t = 0; t < terms.size(); ++t) kernels[t](terms[t], first, width, out);
+    }
+  });
+}
+
+XyzImage relight_compressed(const CompressedTransport& transport, const RelightMatrix& matrix) {
+  XyzImage out;
+  out.width = transport.width;
+  out.height = transport.height;
+  out.xyz.resize(3 * transport.pixel_count());
+  relight_compressed_into(transport, matrix, out.xyz.data());
+  return out;
+}
+
+DisplayEncoder8::DisplayEncoder8(const spectral::DisplayTransform& display) : m_display(&display) {
+  const std::optional<spectral::DisplayMatrixCurve> split = display.split_matrix_curve();
+  if (!split) return;
+  m_matrix = split->matrix.cast<float>();
+  // code_c(v) of the curve for a batch of values (one per pixel, the same in the three channels).
+  auto codes = [&](const std::vector<float>& values) {
+    std::vector<float> rgb(3 * values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = values[i];
+    split->curve(rgb.data(), values.size());
+    std::vector<std::uint8_t> out(rgb.size());
+    for (std::size_t i = 0; i < rgb.size(); ++i) out[i] = std::isfinite(rgb[i]) ? quantise(rgb[i]) : 0;
+    return out;  // out[3·i + c]
+  };
+  // The top of the bracket: where every channel reaches 255, or 2^40.
+  float hi = 1.0f;
+  while (hi < 1.1e12f) {
+    const auto c = codes({hi});
+    if (c[0] == 255 && c[1] == 255 && c[2] == 255) break;
+    hi *= 2.0f;
+  }
+  const auto at_zero = codes({0.0f});
+  const auto at_hi = codes({hi});
+  // Bisection on the bit patterns of non-negative floats (monotone in the value), all 3·255
+  // thresholds at once: invariant code(lo) < j ≤ code(hi).
+  struct Search {
+    int channel, code;
+    std::uint32_t lo, hi;
+  };
+  std::vector<Search> open;
+  for (int c = 0; c < 3; ++c) {
+    for (int j = 1; j < 256; ++j) {
+      float& t = m_thresholds[static_cast<std::size_t>(c)][static_cast<std::size_t>(j)];
+      if (at_zero[static_cast<std::size_t>(c)] >= j) t = 0.0f;
+      else if (at_hi[static_cast<std::size_t>(c)] < j) t = std::numeric_limits<float>::infinity();
+      else open.push_back({c, j, 0u, std::bit_cast<std::uint32_t>(hi)});
+    }
+  }
+  while (true) {
+    std::vector<float> mids;
+    std::vector<std::size_t> which;
+    for (std::size_t i = 0; i < open.size(); ++i) {
+      if (open[i].hi - open[i].lo > 1) {
+        mids.push_back(std::bit_cast<float>(open[i].lo + (open[i].hi - open[i].lo) / 2));
+        which.push_back(i);
+      }
+    }
+    if (mids.empty()) break;
+    const auto c = codes(mids);
+    for (std::size_t m = 0; m < mids.size(); ++m) {
+      Search& s = open[which[m]];
+      const std::uint32_t mid = std::bit_cast<std::uint32_t>(mids[m]);
+      if (c[3 * m + static_cast<std::size_t>(s.channel)] >= s.code) s.hi = mid;
+      else s.lo = mid;
+    }
+  }
+  for (const Search& s : open) {
+    m_thresholds[static_cast<std::size_t>(s.channel)][static_cast<std::size_t>(s.code)] = std::bit_cast<float>(s.hi);
+  }
+  for (std::size_t c = 0; c < 3; ++c) {
+    const auto& thr = m_thresholds[c];
+    // Thresholds must not decrease (a monotone curve); otherwise the bake is not valid.
+    for (std::size_t j = 2; j < 256; ++j)
+      if (thr[j] < thr[j - 1]) return;
+    m_guess[c].resize(0x7F80);
+    for (std::uint32_t b = 0; b < 0x7F80; ++b) {
+      const float v = std::bit_cast<float>(b << 16);
+      m_guess[c][b] = static_cast<std::uint8_t>(std::upper_bound(thr.begin() + 1, thr.end(), v) - (thr.begin() + 1));
+    }
+  }
+  // Check the bake against the full transform on deterministic colours, dark ones and negatives too.
+  constexpr std::size_t kChecks = 4096;
+  std::vector<float> xyz(3 * kChecks);
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  auto uniform = [&]() {
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    return static_cast<float>(static_cast<double>(state >> 11) * 0x1.0p-53);
+  };
+  for (std::size_t i = 0; i < kChecks; ++i) {
+    const float scale = std::pow(10.0f, -4.0f + 4.5f * uniform());
+    for (int c = 0; c < 3; ++c) xyz[3 * i + static_cast<std::size_t>(c)] = scale * (1.2f * uniform() - 0.1f);
+  }
+  std::vector<float> reference = xyz;
+  display.apply(reference.data(), kChecks);
+  m_baked = true;
+  std::vector<std::uint8_t> fast(3 * kChecks);
+  encode_chunk(xyz.data(), kChecks, fast.data());
+  for (std::size_t i = 0; i < fast.size(); ++i) {
+    const int ref = std::isfinite(reference[i]) ? quantise(reference[i]) : 0;
+    if (std::abs(ref - int{fast[i]}) > 1) {
+      m_baked = false;
+      break;
+    }
+  }
+}
+
+void DisplayEncoder8::encode_chunk(const float* xyz, std::size_t pixels, std::uint8_t* rgb) const {
+  if (!m_baked) {
+    std::vector<float> buf(xyz, xyz + 3 * pixels);
+    for (float& v : buf)
+      if (!std::isfinite(v)) v = 0.0f;
+    m_display->apply(buf.data(), pixels);
+    for (std::size_t i = 0; i < buf.size(); ++i) rgb[i] = std::isfinite(buf[i]) ? quantise(buf[i]) : 0;
+    return;
+  }
+  for (std::size_t p = 0; p < pixels; ++p) {
+    float in[3];
+    for (int c = 0; c < 3; ++c) {
+      const float v = xyz[3 * p + static_cast<std::size_t>(c)];
+      in[c] = std::isfinite(v) ? v : 0.0f;
+    }
+    for (int c = 0; c < 3; ++c) {
+      const float v = m_matrix(c, 0) * in[0] + m_matrix(c, 1) * in[1] + m_matrix(c, 2) * in[2];
+      const std::uint32_t bits = std::bit_cast<std::uint32_t>(v);
+      std::uint32_t code;
+      if (bits & 0x80000000u) {
+        code = m_guess[static_cast<std::size_t>(c)][0];  // negative: the code of 0
+      } else if (bits >= 0x7F800000u) {
+        code = 255;
+      } else {
+        code = m_guess[static_cast<std::size_t>(c)][bits >> 16];
+        const auto& thr = m_thresholds[static_cast<std::size_t>(c)];
+        while (code < 255 && v >= thr[code + 1]) ++code;
+      }
+      rgb[3 * p + static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(code);
+    }
+  }
+}
+
+void DisplayEncoder8::encode(const float* xyz, std::size_t pixels, std::uint8_t* rgb) const {
+  constexpr std::size_t kChunk = 16384;
+  const std::size_t chunks = (pixels + kChunk - 1) / kChunk;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const std::size_t first = i * kChunk;
+      const std::size_t count = std::min(kChunk, pixels - first);
+      encode_chunk(xyz + 3 * first, count, rgb + 3 * first);
+    }
+  });
+}
+
+}  // namespace prizma::relight
