@@ -95,20 +95,23 @@ void add_reradiation(const spectral::SpectralImage& image, const RelightMatrix& 
   }
   if (on.empty()) return;
   const Eigen::Matrix3f out = matrix.output().cast<float>();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, image.pixel_count()), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p) {
-      Eigen::Vector3f v = Eigen::Vector3f::Zero();
-      for (int l : on) {
-        const float* kk = k.per_light[static_cast<std::size_t>(l)].data() + p * 3 * ni;
-        const float* el = e.data() + static_cast<std::size_t>(l) * ni;
-        for (int c = 0; c < 3; ++c) {
-          float s = 0.0f;
-          for (std::size_t j = 0; j < ni; ++j) s += kk[static_cast<std::size_t>(c) * ni + j] * el[j];
-          v[c] += s;
+  using Weights = Eigen::Matrix<float, 3, Eigen::Dynamic, Eigen::RowMajor>;
+  using Bins = Eigen::Matrix<float, Eigen::Dynamic, 1>;
+  const auto nk = static_cast<Eigen::Index>(ni);
+  // Rows of pixels, as the diagonal kernel: one task per row, Eigen's packets over the in bins.
+  tbb::parallel_for(tbb::blocked_range<int>(0, image.height), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width);
+      for (std::size_t p = first; p != first + static_cast<std::size_t>(image.width); ++p) {
+        Eigen::Vector3f v = Eigen::Vector3f::Zero();
+        for (int l : on) {
+          const Eigen::Map<const Weights> kk(k.per_light[static_cast<std::size_t>(l)].data() + p * 3 * ni, 3, nk);
+          const Eigen::Map<const Bins> el(e.data() + static_cast<std::size_t>(l) * ni, nk);
+          v.noalias() += kk.lazyProduct(el);
         }
+        const Eigen::Vector3f add = out * v;
+        for (int c = 0; c < 3; ++c) xyz_out[3 * p + static_cast<std::size_t>(c)] += add[c];
       }
-      const Eigen::Vector3f add = out * v;
-      for (int c = 0; c < 3; ++c) xyz_out[3 * p + static_cast<std::size_t>(c)] += add[c];
     }
   });
 }
