@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "prizma/spectral/bispectral.h"
@@ -24,11 +25,22 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("prizma-bispectral-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
+// A file in the temporary folder, named after the process, removed when the test ends.
+class Scratch {
+ public:
+  explicit Scratch(const std::string& name)
+      : m_path(fs::temp_directory_path() / ("prizma-bispectral-" + std::to_string(::getpid()) + "-" + name)) {}
+  ~Scratch() {
+    std::error_code ec;
+    fs::remove(m_path, ec);
+  }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+  const fs::path& path() const { return m_path; }
+
+ private:
+  fs::path m_path;
+};
 
 // 3×2 pixels, 4 bins over 400–600 nm, pairs (0→2), (0→3), (1→3).
 SpectralImage bispectral_image(const std::vector<std::string>& names) {
@@ -55,7 +67,8 @@ TEST(Bispectral, ChannelNamesPutTheExcitationFirst) {
 TEST(Bispectral, RoundTripPerLightLayer) {
   for (const auto& names : {std::vector<std::string>{"uv"}, std::vector<std::string>{"uv", "sky"}}) {
     const SpectralImage img = bispectral_image(names);
-    const fs::path p = scratch("round.exr");
+    const Scratch file("round.exr");
+    const fs::path& p = file.path();
     write_spectral_exr(p, img);
     const SpectralImage back = read_spectral_exr(p);
     EXPECT_EQ(back.reradiation, img.reradiation);
@@ -83,7 +96,8 @@ TEST(Bispectral, ChecksumCoversTheBispectralValues) {
 
 TEST(Bispectral, HalfFilesRoundTripTheHalfValues) {
   const SpectralImage img = bispectral_image({"uv", "sky"});
-  const fs::path p = scratch("half.exr");
+  const Scratch file("half.exr");
+  const fs::path& p = file.path();
   ExrWriteOptions o;
   o.pixel_type = ExrPixelType::Half;
   write_spectral_exr(p, img, o);
@@ -96,7 +110,8 @@ TEST(Bispectral, HalfFilesRoundTripTheHalfValues) {
 // A file as another tool writes the reference layout: no prizma: attributes, wavelengths in other
 // units, only some pairs.
 TEST(Bispectral, ReadsAReferenceLayoutFileFromAnotherWriter) {
-  const fs::path p = scratch("other.exr");
+  const Scratch file("other.exr");
+  const fs::path& p = file.path();
   const int w = 2, h = 1;
   const std::vector<std::string> diag = {"T.500nm", "T.550nm", "T.600nm", "T.650nm"};
   const std::vector<std::string> rerad = {"T.500nm.600nm", "T.0,5um.650nm", "T.550nm.6,5E2nm"};
@@ -132,9 +147,10 @@ TEST(Bispectral, ReadsAReferenceLayoutFileFromAnotherWriter) {
 }
 
 TEST(Bispectral, WriterRefusesBadPairsAndValues) {
-  auto expect_refused = [](const SpectralImage& img, const std::string& reason) {
+  const Scratch bad("bad.exr");
+  auto expect_refused = [&](const SpectralImage& img, const std::string& reason) {
     try {
-      write_spectral_exr(scratch("bad.exr"), img);
+      write_spectral_exr(bad.path(), img);
       FAIL() << "written; expected " << reason;
     } catch (const InputError& e) {
       EXPECT_NE(e.reason().find(reason), std::string::npos) << e.what();
@@ -155,7 +171,7 @@ TEST(Bispectral, WriterRefusesBadPairsAndValues) {
   img = bispectral_image({"uv"});
   img.lights[0].reradiation[2] = std::numeric_limits<float>::quiet_NaN();
   expect_refused(img, "NaN at pixel (0, 0)");
-  EXPECT_FALSE(fs::exists(scratch("bad.exr")));
+  EXPECT_FALSE(fs::exists(bad.path()));
 }
 
 TEST(Bispectral, AddReradiatedIsTheMatrixTimesTheLight) {
