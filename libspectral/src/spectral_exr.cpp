@@ -48,6 +48,7 @@
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/tool_main.h"
+#include "bispectral_exr.h"
 #include "text_util.h"
 
 namespace prizma::spectral {
@@ -236,6 +237,7 @@ std::string spectral_pixel_checksum(const SpectralImage& image) {
     sum += layer_hash(light.data.data(), light.data.size(), kFnvBasisLight);
     if (!light.variance.empty()) sum += layer_hash(light.variance.data(), light.variance.size(), kFnvBasisVariance);
   }
+  sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
   return checksum_string(sum);
 }
 
@@ -431,6 +433,10 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
                 Imf::Slice(type, const_cast<char*>(base + elem * static_cast<std::size_t>(i)), x_stride, y_stride));
     }
   }
+  // Bispectral channels (fluorescence; none, and the header unchanged, for a diagonal image).
+  detail::ReradiationBuffers rerad_buffers;
+  if (const std::uint64_t rc = detail::add_reradiation_for_write(image, multi, half_out, header, fb, rerad_buffers, p); rc != 0)
+    header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum + rc)));
 
   write_atomically(path, [&](AtomicOutput& out) {
     try {
@@ -655,7 +661,12 @@ SpectralImage read_spectral_exr(const fs::path& path) {
     // Classify the channels into layers.
     std::map<std::string, LayerChannels> layers;  // by layer prefix ("" = top level)
     bool any_emissive = false;
+    std::vector<detail::ReradiationChannel> rerad_channels;  // bispectral T.<λin>.<λout>
     for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      if (detail::ReradiationChannel rc; detail::parse_reradiation_channel(it.name(), p, rc)) {
+        rerad_channels.push_back(std::move(rc));
+        continue;
+      }
       const auto parsed = parse_channel_name(it.name(), p);
       if (!parsed) continue;
       if (parsed->emissive) {
@@ -837,6 +848,11 @@ SpectralImage read_spectral_exr(const fs::path& path) {
         add_slices(fb, layers.at(sources[k].variance), light.variance, dw, n);
       }
     }
+    {
+      std::vector<std::string> light_prefixes;
+      for (const auto& s : sources) light_prefixes.push_back(s.layer);
+      detail::add_reradiation_for_read(rerad_channels, light_prefixes, lambdas, image, fb, dw, p);
+    }
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
 
@@ -858,6 +874,7 @@ SpectralImage read_spectral_exr(const fs::path& path) {
         check_finite(image.lights[k].variance, image.width, n, "layer \"" + sources[k].variance + "\"", p);
       }
     }
+    detail::check_reradiation_finite(image, p);
     return image;
   } catch (const InputError&) {
     throw;

@@ -21,11 +21,32 @@ RelightMatrix::RelightMatrix(const spectral::BinLayout& bins, const std::vector<
     m_adaptation = spectral::bradford_adaptation(m_mix_white / m_mix_white.y(), spectral::white_d65());
   }
   const double exposure = std::exp2(opts.exposure_ev);
+  m_output = exposure * m_adaptation;
+  // Bin averages of each light for bispectral terms, normalised as relight_weights normalises.
+  for (const LightSpec& light : lights) {
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(m_bins);
+    if (!light.off && light.scale != 0.0) {
+      double norm = 1.0;
+      if (opts.units == spectral::LightUnits::RelativeToWhite)
+        norm = 1.0 / spectral::relight_weights(cmf, light.spectrum, bins, spectral::LightUnits::Absolute).row(1).sum();
+      for (int i = 0; i < m_bins; ++i)
+        e[i] = light.scale * norm * light.spectrum.integrate(bins.lo_nm(i), bins.hi_nm(i)) / bins.width_nm(i);
+    }
+    m_bin_average.push_back(e);
+  }
   m_stacked.resize(3, static_cast<Eigen::Index>(m_bins) * static_cast<Eigen::Index>(lights.size()));
   for (std::size_t l = 0; l < m_per_light.size(); ++l) {
     m_per_light[l] = exposure * m_adaptation * m_per_light[l];
     m_stacked.middleCols(static_cast<Eigen::Index>(l) * m_bins, m_bins) = m_per_light[l].cast<float>();
   }
+}
+
+Matrix3Xd bin_cmf_integrals(spectral::Observer observer, const spectral::BinLayout& bins) {
+  const spectral::ColorMatching& cmf = spectral::ColorMatching::get(observer);
+  Matrix3Xd m(3, bins.size());
+  for (int i = 0; i < bins.size(); ++i)
+    for (int c = 0; c < 3; ++c) m(c, i) = cmf.channel(c).integrate(bins.lo_nm(i), bins.hi_nm(i));
+  return m;
 }
 
 }  // namespace prizma::relight

@@ -194,7 +194,9 @@ double RelightSession::relight() {
   m_xyz.width = m_image.width;
   m_xyz.height = m_image.height;
   m_xyz.xyz.resize(3 * m_image.pixel_count());
-  relight_into(m_image, m_matrix, m_xyz.xyz.data());
+  if (!m_image.reradiation.empty() && (m_reradiation.per_light.empty() || m_reradiation.cmf != m_matrix.options().cmf))
+    m_reradiation = reradiation_weights(m_image, m_matrix.options().cmf);  // once per observer
+  relight_into(m_image, m_matrix, m_xyz.xyz.data(), m_image.reradiation.empty() ? nullptr : &m_reradiation);
   m_dirty = false;
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

@@ -97,6 +97,7 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
     for (std::size_t l = 0; l < s.lights.size(); ++l)
       if (s.lights[l].name != first.lights[l].name) refuse("lights");
     if (s.info.samples <= 0) throw InputError(name(k), "holds no samples");
+    if (!(s.reradiation == first.reradiation)) refuse("bispectral channels");
     for (const auto& l : s.lights) all_variance = all_variance && !l.variance.empty();
     const auto r = s.info.sample_range.empty()
                        ? std::vector<SampleRange>{{0, s.info.samples}}
@@ -158,6 +159,13 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
       layer.variance.assign(size, 0.0f);
     }
     for (std::size_t k = 0; k < size; ++k) layer.data[k] = static_cast<float>(sum[k]);
+    if (!out.reradiation.empty()) {  // bispectral terms: the same weighted mean
+      std::vector<double> rs(layer.reradiation.size(), 0.0);
+      for (const auto& s : shards)
+        for (std::size_t k = 0; k < rs.size(); ++k)
+          rs[k] += static_cast<double>(s.info.samples) * static_cast<double>(s.lights[l].reradiation[k]);
+      for (std::size_t k = 0; k < rs.size(); ++k) layer.reradiation[k] = static_cast<float>(rs[k] / n_total);
+    }
   }
   out.info.samples = total;
   out.info.sample_range = format_sample_ranges(ranges);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "prizma/render/fluorescence.h"
 #include "prizma/render/phase.h"
 #include "prizma/spectral/error.h"
 
@@ -63,12 +64,24 @@ PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi
   for (std::size_t m = 0; m < med.materials.size(); ++m) {
     const Material& mat = med.materials[m];
     // Round the bound up by one float ulp so that σt at any wavelength never exceeds it.
-    const double smax = spectrum_max_over(mat.sigma_t_per_unit, lambda_lo_nm, lambda_hi_nm);
+    double smax = spectrum_max_over(mat.sigma_t_per_unit, lambda_lo_nm, lambda_hi_nm);
+    if (mat.fluorescent) smax += spectrum_max_over(mat.fluorescence.absorption, lambda_lo_nm, lambda_hi_nm);  // σt + σf
     sigma_t_max[m] = std::nextafter(static_cast<float>(std::max(0.0, smax)), 1e30f);
     m_g_constant.push_back(mat.anisotropy.is_constant() ? 1 : 0);
     const bool emits = mat.emission.max_value() > 0.0;
     m_emits.push_back(emits ? 1 : 0);
     m_any_emission = m_any_emission || emits;
+    const bool fl = mat.fluorescent && mat.fluorescence.quantum_yield > 0.0;
+    m_fluorescent.push_back(fl ? 1 : 0);
+    m_any_fluorescence = m_any_fluorescence || fl;
+    m_fl_emission.push_back(spectral::Spectrum::constant(0.0));
+    if (fl) {
+      const double area = fluorescence_emission_area(mat.fluorescence.emission);
+      if (!(area > 0.0) || !std::isfinite(area) || !(mat.fluorescence.quantum_yield <= 1.0))
+        throw spectral::InputError("medium", "material \"" + mat.name + "\": fluorescence needs an emission of positive area and q in [0, 1]");
+      m_fl_emission.back() = mat.fluorescence.emission.scaled(1.0 / area);
+    }
+    if (mat.fluorescent) m_wavelength_independent = false;
     if (!mat.albedo.is_constant() || !mat.sigma_t_per_unit.is_constant() || !mat.anisotropy.is_constant() ||
         !mat.emission.is_constant())
       m_wavelength_independent = false;
@@ -110,6 +123,18 @@ void PathTracer::prepare(PathScratch& s, int lanes) const {
   for (auto* v : {&s.weight, &s.transmittance, &s.phase, &s.sigma_a, &s.sigma_s, &s.sigma_n, &s.environment, &s.emission})
     v->assign(n, 0.0f);
   s.directional.assign(m_lights.size() * n, 0.0f);
+  s.width_nm.assign(n, 0.0f);
+  s.lo_nm.assign(n, 0.0f);
+  s.fl_active = false;
+  const bool any_fluorescent = std::any_of(m_medium->materials.begin(), m_medium->materials.end(),
+                                           [](const Material& m) { return m.fluorescent; });
+  if (any_fluorescent) {
+    s.fl_out.assign(nm * n, 0.0f);
+    s.fl_in.assign(nm * n, 0.0f);
+    s.fl_lambda_sum.assign(nm, 0.0);
+    for (auto* v : {&s.zero_g, &s.fl_a, &s.fl_environment, &s.fl_emission}) v->assign(n, 0.0f);
+    s.fl_directional.assign(m_lights.size() * n, 0.0f);
+  }
 }
 
 bool PathTracer::hits_medium(const Ray& ray) const {
@@ -133,7 +158,45 @@ void PathTracer::evaluate_material(int m, PathScratch& s) const {
     g[i] = static_cast<float>(std::clamp(mat.anisotropy.eval(l), -0.9999, 0.9999));
     if (m_emits[m]) le[i] = static_cast<float>(std::max(0.0, mat.emission.eval(l)));
   }
+  if (mat.fluorescent) evaluate_fluorescence(m, s);
   s.material_stamp[m] = s.path_id;
+}
+
+void PathTracer::evaluate_fluorescence(int m, PathScratch& s) const {
+  // σf joins the extinction (the albedo rescaled so that σs stays albedo·σt), and the two sides of
+  // the event. Energy radiance: a photon absorbed at λin carries hc/λin, one re-emitted at λout
+  // hc/λout, so the source at λout is q·ρ(λout)·∫ σf(λin)·(λin/λout)·L̄(λin) dλin (ρ the normalised
+  // emission, L̄ the radiance averaged over directions). Over the path's jittered lanes
+  // ∫ σf·λ·L̄ dλ ≈ Σ_j Δj·σf(λj)·λj·L̄(λj) (unbiased per bin), so the source at lane i is
+  // Φ_i·Σ_j p_j·L̄(λj) with Φ_i = q·ρ(λi)/λi·Λ, p_j = Δj·σf(λj)·λj/Λ and Λ = Σ_j Δj·σf(λj)·λj.
+  const Material& mat = m_medium->materials[m];
+  const int n = s.lanes;
+  float* st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
+  float* al = s.albedo.data() + static_cast<std::size_t>(m) * n;
+  float* fo = s.fl_out.data() + static_cast<std::size_t>(m) * n;
+  float* fi = s.fl_in.data() + static_cast<std::size_t>(m) * n;
+  double big_lambda = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double l = s.lambda_nm[i];
+    const auto sf = static_cast<float>(std::max(0.0, mat.fluorescence.absorption.eval(l)));
+    const float st0 = st[i];
+    st[i] = st0 + sf;
+    al[i] = st[i] > 0.0f ? al[i] * (st0 / st[i]) : 0.0f;
+    fi[i] = static_cast<float>(static_cast<double>(s.width_nm[i]) * sf * l);
+    big_lambda += fi[i];
+  }
+  s.fl_lambda_sum[m] = big_lambda;
+  if (!m_fluorescent[m] || !(big_lambda > 0.0)) {
+    std::fill(fo, fo + n, 0.0f);
+    std::fill(fi, fi + n, 0.0f);
+    return;
+  }
+  const double q = mat.fluorescence.quantum_yield;
+  for (int i = 0; i < n; ++i) {
+    const double l = s.lambda_nm[i];
+    fo[i] = static_cast<float>(q * std::max(0.0, m_fl_emission[m].eval(l)) / l * big_lambda);
+    fi[i] = static_cast<float>(fi[i] / big_lambda);
+  }
 }
 
 void PathTracer::lookup(const Eigen::Vector3d& p, std::uint16_t& material, float& density) const {
@@ -269,18 +332,23 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     s.path_id = 1;
   }
   float* __restrict w = s.weight.data();
-  float* __restrict env = s.environment.data();
+  float* env = s.environment.data();  // not restrict: re-pointed at a fluorescent event
   float* __restrict sa = s.sigma_a.data();
   float* __restrict ss = s.sigma_s.data();
   float* __restrict sn = s.sigma_n.data();
   float* __restrict f = s.phase.data();
-  float* __restrict em = s.emission.data();
+  float* em = s.emission.data();
   for (int i = 0; i < n; ++i) {
     w[i] = 1.0f;
     env[i] = 0.0f;
     em[i] = 0.0f;
   }
   std::fill(s.directional.begin(), s.directional.end(), 0.0f);
+  // Where light seen from here on goes: the diagonal results, or after a fluorescent event the
+  // in side of the rank-one term (fl_*).
+  float* dir_out = s.directional.data();
+  s.fl_active = false;
+  bool isotropic = false;  // the last event was a fluorescent re-emission (phase 1/4π)
 
   Eigen::Vector3d pos = camera_ray.origin;
   Eigen::Vector3d dir = camera_ray.direction;
@@ -322,7 +390,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
         if (s.material_stamp[m] != s.path_id) evaluate_material(m, s);
         const float* __restrict st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
         const float* __restrict al = s.albedo.data() + static_cast<std::size_t>(m) * n;
-        float ma = 0.0f, ms = 0.0f, mn = 0.0f;
+        float ma = 0.0f, ms = 0.0f, mn = 0.0f, mf = 0.0f;
         for (int i = 0; i < n; ++i) {
           const float sig_t = d * st[i];
           ss[i] = sig_t * al[i];
@@ -332,6 +400,13 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
           ms = std::max(ms, w[i] * ss[i]);
           mn = std::max(mn, w[i] * sn[i]);
         }
+        const float* __restrict fo = nullptr;
+        if (m_fluorescent[m]) {
+          // The fluorescent source is a fourth event, of "coefficient" d·Φ_i (evaluate_fluorescence);
+          // σf itself is in σa (absorbed at the lane's own wavelength).
+          fo = s.fl_out.data() + static_cast<std::size_t>(m) * n;
+          for (int i = 0; i < n; ++i) mf = std::max(mf, w[i] * d * fo[i]);
+        }
         if (m_emits[m]) {
           // Emission, pbrt-v4's estimator: at every tentative collision, before the event is chosen,
           // w_i σa,i Le,i / μ̄ (collisions come at rate μ̄, so the sum estimates ∫ T σa Le ds; the
@@ -340,7 +415,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
           const float* __restrict le = s.emission_le.data() + static_cast<std::size_t>(m) * n;
           for (int i = 0; i < n; ++i) em[i] += w[i] * sa[i] * le[i] * inv_mu;
         }
-        const float c = ma + ms + mn;
+        const float c = ma + ms + mf + mn;  // mf = 0 without fluorescence: the sum as before
         if (!(c > 0.0f)) return;
         const float xi = rng.uniform() * c;
         if (xi < ma) return;  // absorbed: no emission, the path ends
@@ -352,6 +427,20 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
           pos = p;
           material = m;
           scattered = true;
+          isotropic = false;
+          break;
+        }
+        if (mf > 0.0f && xi < ma + ms + mf) {
+          fluoresce(m, d, c / (mu * mf), rng, s);
+          if (env != s.fl_environment.data()) {
+            env = s.fl_environment.data();
+            em = s.fl_emission.data();
+            dir_out = s.fl_directional.data();
+          }
+          pos = p;
+          material = m;
+          scattered = true;
+          isotropic = true;
           break;
         }
         if constexpr (kLanes != 1) {
@@ -368,8 +457,8 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     if (m_max_bounces >= 0 && bounces >= m_max_bounces) return;
     ++bounces;
 
-    const float* __restrict g = s.g.data() + static_cast<std::size_t>(material) * n;
-    const bool g_constant = kLanes == 1 || m_g_constant[material];
+    const float* __restrict g = isotropic ? s.zero_g.data() : s.g.data() + static_cast<std::size_t>(material) * n;
+    const bool g_constant = kLanes == 1 || isotropic || m_g_constant[material];
 
     // Next-event estimation of every directional light: direction (delta, or uniform in the cone
     // with radiance 1/Ω, so the estimate is phase × transmittance either way), transmittance by
@@ -384,7 +473,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
       const auto cos_theta = static_cast<float>(dir.dot(wl));
       transmittance<kLanes>(pos, wl, rng, s);
       const float* __restrict T = s.transmittance.data();
-      float* __restrict out = s.directional.data() + l * static_cast<std::size_t>(n);
+      float* __restrict out = dir_out + l * static_cast<std::size_t>(n);
       if (g_constant) {
         const float p = hg_phase(cos_theta, g[0]);
         for (int i = 0; i < n; ++i) out[i] += w[i] * p * T[i];
@@ -443,6 +532,52 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
       for (int i = 0; i < n; ++i) env[i] += w[i];
       return;
     }
+  }
+}
+
+void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch& s) const {
+  // The event's weight on the out side, a_i = w_i·d·Φ_i·c/(μ̄·mf) (the spectral-tracking factor of
+  // the event), then the lanes carry λin with weights p_j. The path's transport is rank one from
+  // here on: M[out][in] += a[out]·(what lane in sees). A later event keeps a and scales the lanes by
+  // Σ_i a'_i (Φ and p are rank one too, so the state stays rank one however many events chain).
+  // The in side gets wavelengths of its own, λ'_j = lo_j + u'·Δλ_j with a fresh u': with the out
+  // side's jitter, E[f(λ_out)·g(λ_in)] over the shared u is not the product of the bin averages
+  // (a bias of 30 % in the tests). Φ was evaluated with Λ at the old wavelengths; the estimate of
+  // ∫ σf·λ·L̄ dλ must use the new ones, hence the factor Λ'/Λ (the event's probability may use any Λ).
+  const int n = s.lanes;
+  float* w = s.weight.data();
+  const float* fo = s.fl_out.data() + static_cast<std::size_t>(m) * n;
+  const double old_sum = s.fl_lambda_sum[m];
+  float total = 0.0f;  // later events: Σ_i a'_i
+  if (!s.fl_active) {
+    for (int i = 0; i < n; ++i) s.fl_a[i] = w[i] * density * fo[i] * k;
+  } else {
+    for (int i = 0; i < n; ++i) total += w[i] * density * fo[i] * k;
+  }
+  const double u = rng.uniform_double();
+  for (int i = 0; i < n; ++i) s.lambda_nm[i] = static_cast<float>(s.lo_nm[i] + u * s.width_nm[i]);
+  if (++s.path_id == 0) {  // every material is evaluated anew at the new wavelengths
+    std::fill(s.material_stamp.begin(), s.material_stamp.end(), 0u);
+    s.path_id = 1;
+  }
+  evaluate_material(m, s);
+  const auto ratio = static_cast<float>(old_sum > 0.0 ? s.fl_lambda_sum[m] / old_sum : 0.0);
+  const float* fi = s.fl_in.data() + static_cast<std::size_t>(m) * n;
+  float pmax = 0.0f;
+  for (int j = 0; j < n; ++j) pmax = std::max(pmax, fi[j]);
+  if (!s.fl_active) {
+    // First event: the diagonal results so far stay; the in side starts empty. The lanes' largest
+    // weight is made 1 (its scale moved to a) so that Russian roulette sees a unit path.
+    for (int i = 0; i < n; ++i) s.fl_a[i] *= ratio * pmax;
+    std::fill(s.fl_environment.begin(), s.fl_environment.end(), 0.0f);
+    std::fill(s.fl_emission.begin(), s.fl_emission.end(), 0.0f);
+    std::fill(s.fl_directional.begin(), s.fl_directional.end(), 0.0f);
+    s.fl_active = true;
+    const float inv = pmax > 0.0f ? 1.0f / pmax : 0.0f;
+    for (int j = 0; j < n; ++j) w[j] = fi[j] * inv;
+  } else {
+    total *= ratio;
+    for (int j = 0; j < n; ++j) w[j] = total * fi[j];
   }
 }
 

@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "prizma/render/camera.h"
+#include "prizma/render/fluorescence.h"
 #include "prizma/render/path_tracer.h"
 #include "prizma/render/rng.h"
 #include "prizma/render/sample_range.h"
@@ -36,6 +37,7 @@ enum class LaneMode { AllBins, Replicated, Single };
 struct ThreadState {
   PathScratch path;
   std::vector<double> value;  // [light][bin] of one sample
+  std::vector<double> value_fl;  // [light][bispectral pair] of one sample (fluorescent scenes)
   std::int64_t paths = 0;
   std::int64_t nan_or_inf = 0;
   std::int64_t converged = 0;
@@ -79,6 +81,12 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   else if (tracer.wavelength_independent())
     mode = LaneMode::Replicated;
   const int lanes = mode == LaneMode::AllBins ? nb : 1;
+  // Fluorescence (docs/fluorescence.md): the bispectral pairs the scene can fill; nothing of it
+  // runs for a scene without fluorescence.
+  const FluorescenceLayout fluor = fluorescence_layout(scene.medium, bins);
+  if (fluor.any && mode == LaneMode::Single)
+    throw InputError("wavelength_sampling", "fluorescence is rendered with spectral-tracking only (all bins per path); "
+                                            "single does not change a path's wavelength yet");
 
   // Where each light's per-lane radiance comes from: the environment (−1), the medium's emission
   // (−2) or a directional light.
@@ -107,11 +115,22 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   std::vector<double> total_sum(adaptive ? pixels : 0, 0.0), total_sq(adaptive ? pixels : 0, 0.0);
   std::vector<std::int64_t> count(pixels, 0);
   std::vector<char> converged(pixels, 0);
+  const bool fluorescent = fluor.any && mode == LaneMode::AllBins;
+  const std::size_t np = fluor.pairs.size();
+  const std::size_t per_pixel_fl = fluorescent && st.fold_light_spectra ? 0 : static_cast<std::size_t>(nl) * np;
+  std::vector<double> sum_fl(fluorescent ? pixels * per_pixel_fl : 0, 0.0);
 
   tbb::enumerable_thread_specific<ThreadState> states([&] {
     ThreadState t;
     tracer.prepare(t.path, lanes);
     t.value.assign(per_pixel, 0.0);
+    if (fluorescent) {
+      t.value_fl.assign(per_pixel_fl, 0.0);
+      for (int i = 0; i < nb; ++i) {
+        t.path.lo_nm[i] = static_cast<float>(bins.lo_nm(i));
+        t.path.width_nm[i] = static_cast<float>(bins.width_nm(i));
+      }
+    }
     return t;
   });
 
@@ -127,6 +146,40 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
     if (callbacks.cancel == nullptr || !callbacks.cancel->load(std::memory_order_relaxed)) return false;
     pass_cut.store(true, std::memory_order_relaxed);
     return true;
+  };
+  // A fluorescent path's rank-one term, M[out][in] = a[out]·(in side)[in] per light: off-diagonal
+  // pairs into vf, diagonal ones into the sample's transport (ts.value). Folded lights (test mode)
+  // weigh the in side by the light at λin and everything goes to the diagonal (the radiance at out).
+  // False when a value is not finite.
+  auto add_fluorescent_sample = [&](const PathScratch& ps, double* v, double* vf) -> bool {
+    std::fill(vf, vf + per_pixel_fl, 0.0);
+    if (!ps.fl_active) return true;
+    bool ok = true;
+    const float* a = ps.fl_a.data();
+    for (int l = 0; l < nl; ++l) {
+      const float* src = source[l] == -2 ? ps.fl_emission.data()
+                         : source[l] < 0 ? ps.fl_environment.data()
+                                         : ps.fl_directional.data() + static_cast<std::size_t>(source[l]) * lanes;
+      double* out = v + static_cast<std::size_t>(l) * nb;
+      // λin: the path's last wavelengths (a fluorescent event draws them anew; with two or more
+      // events chained the folded light is taken at the last segment's, an approximation of the
+      // test mode only).
+      auto fold_at = [&](int i) { return fold.empty() ? 1.0 : fold[l].eval(ps.lambda_nm[i]); };
+      for (std::size_t k = 0; k < np; ++k) {
+        const spectral::BinPair pr = fluor.pairs[k];
+        const double val = static_cast<double>(a[pr.out]) * src[pr.in] * fold_at(pr.in);
+        ok = ok && std::isfinite(val);
+        if (fold.empty())
+          vf[static_cast<std::size_t>(l) * np + k] = val;
+        else
+          out[pr.out] += val;
+      }
+      for (int i : fluor.diagonal) {
+        out[i] += static_cast<double>(a[i]) * src[i] * fold_at(i);
+        ok = ok && std::isfinite(out[i]);
+      }
+    }
+    return ok;
   };
   auto render_pixel = [&](ThreadState& ts, int x, int y, std::int64_t s0, std::int64_t s1) {
     const std::size_t pix = static_cast<std::size_t>(y) * width + x;
@@ -183,10 +236,16 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
         }
         for (int i = 0; i < nb; ++i) finite = finite && std::isfinite(out[i]);
       }
+      if (fluorescent) finite = add_fluorescent_sample(ps, v, ts.value_fl.data()) && finite;
       if (!finite) {
         // Never let a NaN/Inf reach the image: count it, take the sample as 0.
         ++ts.nan_or_inf;
         std::fill(v, v + per_pixel, 0.0);
+        std::fill(ts.value_fl.begin(), ts.value_fl.end(), 0.0);
+      }
+      if (per_pixel_fl > 0) {
+        double* acc_fl = sum_fl.data() + pix * per_pixel_fl;
+        for (std::size_t k = 0; k < per_pixel_fl; ++k) acc_fl[k] += ts.value_fl[k];
       }
       double sample_total = 0.0;
       for (std::size_t k = 0; k < per_pixel; ++k) {
@@ -227,7 +286,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   bool interrupted = false;
   // The accumulators before the current pass, kept only when the render can be cancelled.
   struct Snapshot {
-    std::vector<double> sum, sum_sq, total_sum, total_sq;
+    std::vector<double> sum, sum_sq, total_sum, total_sq, sum_fl;
     std::vector<std::int64_t> count;
     std::vector<char> converged;
   } before;
@@ -240,6 +299,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
     const std::int64_t s1 = std::min(st.sample_end, s0 + per_pass);
     if (callbacks.cancel) {
       before.sum.assign(sum.begin(), sum.end());
+      before.sum_fl.assign(sum_fl.begin(), sum_fl.end());
       before.sum_sq.assign(sum_sq.begin(), sum_sq.end());
       before.total_sum.assign(total_sum.begin(), total_sum.end());
       before.total_sq.assign(total_sq.begin(), total_sq.end());
@@ -252,6 +312,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
       run_pass(s0, s1);
     if (pass_cut.load()) {
       sum.swap(before.sum);
+      sum_fl.swap(before.sum_fl);
       sum_sq.swap(before.sum_sq);
       total_sum.swap(before.total_sum);
       total_sq.swap(before.total_sq);
@@ -297,6 +358,19 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
           const double var = std::max(0.0, (sum_sq[k] / n - mean * mean) * n / (n - 1.0));
           layer.variance[pix * nb + i] = static_cast<float>(var / n);
         }
+      }
+    }
+  }
+  if (per_pixel_fl > 0) {
+    // The bispectral terms (docs/spectral-exr.md, "Bispectral channels"): per light, pairs contiguous.
+    img.reradiation = fluor.pairs;
+    for (int l = 0; l < nl; ++l) {
+      auto& r = img.lights[l].reradiation;
+      r.assign(pixels * np, 0.0f);
+      for (std::size_t pix = 0; pix < pixels; ++pix) {
+        const double n = static_cast<double>(count[pix]);
+        for (std::size_t k = 0; k < np; ++k)
+          r[pix * np + k] = n > 0 ? static_cast<float>(sum_fl[pix * per_pixel_fl + static_cast<std::size_t>(l) * np + k] / n) : 0.0f;
       }
     }
   }

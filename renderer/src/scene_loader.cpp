@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "prizma/render/scene.h"
+#include "prizma/render/fluorescence.h"
 #include "prizma/render/transfer_function.h"
 #include "prizma/render/volume.h"
 #include "prizma/spectral/error.h"
@@ -284,6 +285,33 @@ ValueNormalisation read_normalisation(const Reader& rd, const json& root, const 
   return n;
 }
 
+// A material's "fluorescence": {"absorption": SPEC, "emission": SPEC, "quantum_yield": q}
+// (docs/scene-format.md). The emission's scale does not matter (the renderer normalises its area).
+void read_fluorescence(const Reader& rd, const json& j, const std::string& path, Material& m) {
+  rd.expect_object(j, path, {"absorption", "emission", "quantum_yield"});
+  for (const char* key : {"absorption", "emission", "quantum_yield"})
+    if (!j.contains(key)) rd.fail(Reader::join(path, key), "is required");
+  Fluorescence f;
+  const std::string ap = Reader::join(path, "absorption");
+  f.absorption = rd.spectrum(j.at("absorption"), ap);
+  if (!(f.absorption.min_value() >= 0.0) || !std::isfinite(f.absorption.max_value()))
+    rd.fail(ap, "must be ≥ 0 and finite at every wavelength (got values in [" + num(f.absorption.min_value()) + ", " +
+                    num(f.absorption.max_value()) + "])");
+  const std::string ep = Reader::join(path, "emission");
+  f.emission = rd.spectrum(j.at("emission"), ep);
+  if (!(f.emission.min_value() >= 0.0) || !std::isfinite(f.emission.max_value()))
+    rd.fail(ep, "must be ≥ 0 and finite at every wavelength (got values in [" + num(f.emission.min_value()) + ", " +
+                    num(f.emission.max_value()) + "])");
+  if (!(fluorescence_emission_area(f.emission) > 0.0))
+    rd.fail(ep, "has no area over 360–830 nm: the re-emitted photons need a spectrum to be drawn from");
+  const std::string qp = Reader::join(path, "quantum_yield");
+  f.quantum_yield = rd.number(j.at("quantum_yield"), qp);
+  if (!(f.quantum_yield >= 0.0 && f.quantum_yield <= 1.0))
+    rd.fail(qp, "must be in [0, 1], the fraction of absorbed photons re-emitted (got " + num(f.quantum_yield) + ")");
+  m.fluorescent = true;
+  m.fluorescence = std::move(f);
+}
+
 TransferFunction read_materials(const Reader& rd, const json& j, const ValueNormalisation& norm) {
   const std::string path = "materials";
   if (!j.is_array()) rd.fail(path, "must be an array of materials (got " + Reader::describe(j) + ")");
@@ -295,7 +323,8 @@ TransferFunction read_materials(const Reader& rd, const json& j, const ValueNorm
   for (std::size_t i = 0; i < j.size(); ++i) {
     const std::string mp = Reader::index(path, i);
     const json& mj = j[i];
-    rd.expect_object(mj, mp, {"name", "range", "units", "albedo", "extinction", "anisotropy", "density", "emission"});
+    rd.expect_object(mj, mp, {"name", "range", "units", "albedo", "extinction", "anisotropy", "density", "emission",
+                          "fluorescence"});
     Material m;
     m.name = mj.contains("name") ? rd.string(mj.at("name"), Reader::join(mp, "name")) : "material" + std::to_string(i);
     if (m.name.empty()) rd.fail(Reader::join(mp, "name"), "must not be empty");
@@ -350,6 +379,7 @@ TransferFunction read_materials(const Reader& rd, const json& j, const ValueNorm
                          ", " + num(m.emission.max_value()) + "])");
       }
     }
+    if (mj.contains("fluorescence")) read_fluorescence(rd, mj.at("fluorescence"), Reader::join(mp, "fluorescence"), m);
 
     if (mj.contains("density")) {
       const std::string dp = Reader::join(mp, "density");
@@ -572,7 +602,9 @@ void check_trackable(const Reader& rd, const Medium& med, bool has_materials) {
   }
   for (std::size_t m = 0; m < med.materials.size(); ++m) {
     if (!(max_density[m] > 0.0f)) continue;
-    const double mu = med.materials[m].sigma_t_per_unit.max_value() * static_cast<double>(max_density[m]);
+    const Material& mat = med.materials[m];
+    const double sigma_f = mat.fluorescent ? mat.fluorescence.absorption.max_value() : 0.0;
+    const double mu = (mat.sigma_t_per_unit.max_value() + sigma_f) * static_cast<double>(max_density[m]);
     if (mu <= kMaxExtinctionPerUnit) continue;
     const std::string field = has_materials ? Reader::join(Reader::index("materials", m), "extinction")
                                             : "transfer_function.extinction_scale";
@@ -855,6 +887,11 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverr
     h.add_spectrum(m.sigma_t_per_unit);
     h.add_spectrum(m.anisotropy);
     if (m.emission.max_value() > 0.0) h.add_spectrum(m.emission);  // hashes of scenes without emission unchanged
+    if (m.fluorescent) {  // likewise without fluorescence
+      h.add_spectrum(m.fluorescence.absorption);
+      h.add_spectrum(m.fluorescence.emission);
+      h.add(&m.fluorescence.quantum_yield, sizeof m.fluorescence.quantum_yield);
+    }
   }
   scene.hash = h.hex();
   return scene;

@@ -30,6 +30,17 @@ struct TransportLayer {
   std::string name;              // light name; letters, digits, '_' and '-'
   std::vector<float> data;
   std::vector<float> variance;   // empty or same size: per-pixel variance of the mean
+  // Bispectral (fluorescence) terms M[out][in], in ≠ out, for the pairs SpectralImage::reradiation
+  // lists: empty, or pixel_count()·reradiation.size() floats, pixel-major, pairs contiguous
+  // (docs/spectral-exr.md, "Bispectral channels"). The diagonal M[i][i] is `data`.
+  std::vector<float> reradiation;
+};
+
+// A bispectral term: light absorbed in bin `in` re-emitted into bin `out` (in ≠ out).
+struct BinPair {
+  int in = 0;
+  int out = 0;
+  bool operator==(const BinPair&) const = default;
 };
 
 struct SpectralImage {
@@ -38,6 +49,9 @@ struct SpectralImage {
   BinLayout bins;
   std::vector<TransportLayer> lights;  // at least one
   SpectralExrInfo info;
+  // The bispectral pairs every light's `reradiation` holds, sorted by (in, out); empty for a
+  // wavelength-diagonal image (no fluorescence), which is then written exactly as before.
+  std::vector<BinPair> reradiation;
 
   std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
   // Index of the light with this name, or -1.

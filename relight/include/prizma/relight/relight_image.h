@@ -11,7 +11,19 @@ namespace prizma::relight {
 // the matrix does not match the image's layer or bin count.
 XyzImage relight_image(const spectral::SpectralImage& image, const RelightMatrix& matrix);
 
+// The per-pixel weights K[c][in] = Σ_out cmf_c(out)·M[out][in] of every light of a bispectral
+// (fluorescent) image, for one observer (spectral::reradiation_colour_weights); empty per_light for
+// a diagonal image. Computed once per image and observer: relighting then adds K·ē per pixel.
+struct ReradiationWeights {
+  spectral::Observer cmf = spectral::Observer::Cie1931_2deg;
+  std::vector<int> in_bins;
+  std::vector<std::vector<float>> per_light;  // [light]: pixels × 3 × in_bins.size()
+};
+ReradiationWeights reradiation_weights(const spectral::SpectralImage& image, spectral::Observer cmf);
+
 // The same into a caller-owned buffer of 3·width·height floats (reused across interactive relights).
-void relight_into(const spectral::SpectralImage& image, const RelightMatrix& matrix, float* xyz_out);
+// For a bispectral image, `k` (for the matrix's observer) is used when given, else computed.
+void relight_into(const spectral::SpectralImage& image, const RelightMatrix& matrix, float* xyz_out,
+                  const ReradiationWeights* k = nullptr);
 
 }  // namespace prizma::relight

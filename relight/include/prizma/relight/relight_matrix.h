@@ -44,6 +44,13 @@ class RelightMatrix {
   // The adaptation applied (identity unless adapt_to_d65 and some light is on).
   const Eigen::Matrix3d& adaptation() const { return m_adaptation; }
   const RelightOptions& options() const { return m_options; }
+  // Bispectral (fluorescent) images, docs/fluorescence.md: light l's bin averages ē_i =
+  // (1/Δλ_i)·∫_{bin i} E dλ with the same normalisation and scale as light(l) (zero when off), and
+  // the 3×3 applied after the per-pixel product (exposure × adaptation), so that the re-radiated
+  // XYZ is output() · Σ_in K[c][in]·ē[in], K from the CMFs integrated over the out bins
+  // (bin_cmf_integrals()).
+  const Eigen::VectorXd& light_bin_average(int l) const { return m_bin_average[static_cast<std::size_t>(l)]; }
+  const Eigen::Matrix3d& output() const { return m_output; }
 
  private:
   int m_bins = 0;
@@ -51,7 +58,12 @@ class RelightMatrix {
   Matrix3Xf m_stacked;
   Eigen::Vector3d m_mix_white = Eigen::Vector3d::Zero();
   Eigen::Matrix3d m_adaptation = Eigen::Matrix3d::Identity();
+  std::vector<Eigen::VectorXd> m_bin_average;
+  Eigen::Matrix3d m_output = Eigen::Matrix3d::Identity();
   RelightOptions m_options;
 };
+
+// ∫_{bin} cmf_c dλ for every bin (3×n): the XYZ of a radiance constant inside each bin.
+Matrix3Xd bin_cmf_integrals(spectral::Observer observer, const spectral::BinLayout& bins);
 
 }  // namespace prizma::relight

@@ -10,6 +10,7 @@
 
 #include "prizma/relight/light_spec.h"
 #include "prizma/relight/output_image.h"
+#include "prizma/relight/relight_image.h"
 #include "prizma/relight/relight_matrix.h"
 #include "prizma/relight/xyz_image.h"
 #include "prizma/spectral/display.h"
@@ -103,6 +104,7 @@ class RelightSession {
   std::unique_ptr<spectral::DisplayTransform> m_display;
   spectral::DisplayOptions m_display_options;
   XyzImage m_xyz;
+  ReradiationWeights m_reradiation;  // bispectral images: K per observer (relight_image.h)
   bool m_dirty = true;
 };
 

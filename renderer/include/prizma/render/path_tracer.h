@@ -41,6 +41,23 @@ struct PathScratch {
   std::vector<float> environment;   // [lanes] result: radiance from the unit environment
   std::vector<float> directional;   // [directional light][lanes] result
   std::vector<float> emission;      // [lanes] result: radiance emitted by the medium (the emission light)
+  // Fluorescence (docs/fluorescence.md; sized only when a material fluoresces). The caller sets
+  // lo_nm and width_nm (each lane's bin; width 0 = the lane takes no part in fluorescence). A
+  // fluorescent event draws the lanes' wavelengths anew (lo + u'·width): lambda_nm then holds the
+  // last segment's wavelengths.
+  std::vector<float> lo_nm;         // [lanes]
+  std::vector<float> width_nm;      // [lanes]
+  std::vector<double> fl_lambda_sum;  // [material] Λ at the path's current wavelengths
+  std::vector<float> fl_out;        // [material][lanes] Φ_i = q·ρ(λi)/λi·Λ per unit density (see trace)
+  std::vector<float> fl_in;         // [material][lanes] p_j = Δj·σf(λj)·λj / Λ, Λ = Σ_j Δj·σf(λj)·λj
+  std::vector<float> zero_g;        // [lanes] g = 0: the isotropic re-emission
+  // Result of a path that fluoresced (fl_active): its transport is rank one, M[out][in] +=
+  // fl_a[out]·fl_<light>[in], on top of the diagonal results above (the part before the first event).
+  bool fl_active = false;
+  std::vector<float> fl_a;            // [lanes] out side
+  std::vector<float> fl_environment;  // [lanes] in side, per light as the diagonal results
+  std::vector<float> fl_directional;  // [directional light][lanes]
+  std::vector<float> fl_emission;     // [lanes]
   PathCounters counters;
 };
 
@@ -68,6 +85,8 @@ class PathTracer {
   void lookup(const Eigen::Vector3d& p, std::uint16_t& material, float& density) const;
   // True when every material's spectra are constant: one lane serves all bins.
   bool wavelength_independent() const { return m_wavelength_independent; }
+  // True when some material fluoresces (the path then may move weight between lanes).
+  bool any_fluorescence() const { return m_any_fluorescence; }
 
  private:
   struct DirectionalLight {
@@ -79,6 +98,8 @@ class PathTracer {
   template <int kLanes>
   void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s) const;
   void evaluate_material(int m, PathScratch& s) const;
+  void evaluate_fluorescence(int m, PathScratch& s) const;
+  void fluoresce(int m, float density, float k, Rng& rng, PathScratch& s) const;
   // Trilinear: the raw value at p (NaN when a contributing voxel is not finite), and its class.
   float interpolate(const Eigen::Vector3d& p) const;
   void classify(float value, std::uint16_t& material, float& density) const;
@@ -90,6 +111,9 @@ class PathTracer {
   std::vector<int> m_directional_index;
   std::vector<char> m_g_constant;  // per material
   std::vector<char> m_emits;       // per material: emission > 0 somewhere
+  std::vector<char> m_fluorescent;  // per material: fluoresces with q > 0
+  std::vector<spectral::Spectrum> m_fl_emission;  // per material: emission normalised to unit area
+  bool m_any_fluorescence = false;
   bool m_any_emission = false;
   int m_emission_light = -1;
   bool m_trilinear = false;

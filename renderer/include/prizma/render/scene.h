@@ -15,6 +15,16 @@
 
 namespace prizma::render {
 
+// Fluorescence of a material (docs/fluorescence.md): an extra absorption coefficient σf per scene
+// unit at density 1 (added to the extinction), the spectrum of the re-emitted photons (normalised by
+// the renderer to unit area over its table, so any scale may be given) and the quantum yield q, the
+// fraction of absorbed photons re-emitted, isotropically.
+struct Fluorescence {
+  spectral::Spectrum absorption = spectral::Spectrum::constant(0.0);
+  spectral::Spectrum emission = spectral::Spectrum::constant(0.0);
+  double quantum_yield = 0.0;
+};
+
 // One material of the transfer function. Spectra are evaluated at each path's own wavelengths.
 struct Material {
   std::string name;
@@ -24,6 +34,8 @@ struct Material {
   // Emitted radiance Le at density 1, ≥ 0 (source term σa·density·Le, as in pbrt-v4); it reaches the
   // image through the scene's emission light layer (Light::emission).
   spectral::Spectrum emission = spectral::Spectrum::constant(0.0);
+  bool fluorescent = false;  // the material fluoresces (the scene's "fluorescence" field)
+  Fluorescence fluorescence;
 };
 
 // How the tracer reads the volume at a point: the nearest voxel's classification (blocks), or the

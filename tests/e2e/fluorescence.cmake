@@ -1,0 +1,40 @@
+# End-to-end tests of fluorescence (docs/fluorescence.md): data/scenes/fluorescent_dye.json rendered
+# small in two shards, merged (the bispectral channels too), relit under a violet LED; a fluorescent
+# scene with --wavelength-sampling single is one error line, exit 2, no file.
+if(NOT TARGET prizma-render OR NOT TARGET prizma-relight)
+  return()
+endif()
+
+set(_fl_work ${PRIZMA_E2E_WORK}/fluorescence)
+set(_fl_scene ${PRIZMA_SOURCE_DATA_DIR}/scenes/fluorescent_dye.json)
+
+function(prizma_fluorescence_e2e name exe args)
+  set(defs -DEXE=${exe} "-DARGS=${args}" -DWORKDIR=${_fl_work})
+  set(extra ${ARGN})
+  set(props "")
+  while(extra)
+    list(POP_FRONT extra key value)
+    if(key STREQUAL "FIXTURES_SETUP" OR key STREQUAL "FIXTURES_REQUIRED")
+      list(APPEND props ${key} ${value})
+    else()
+      list(APPEND defs "-D${key}=${value}")
+    endif()
+  endwhile()
+  add_test(NAME fluorescence.e2e.${name}
+           COMMAND ${CMAKE_COMMAND} ${defs} -P ${PRIZMA_E2E_DIR}/render/run_and_check.cmake)
+  set_tests_properties(fluorescence.e2e.${name} PROPERTIES ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}"
+                       RESOURCE_LOCK fluorescence_e2e_work ${props})
+endfunction()
+
+set(_small "--width|16|--height|16|--threads|2|-q")
+prizma_fluorescence_e2e(shard0 $<TARGET_FILE:prizma-render> "${_fl_scene}|--samples|0:2|-o|dye0.exr|${_small}"
+  MUST_EXIST dye0.exr FIXTURES_SETUP fluorescence_shards)
+prizma_fluorescence_e2e(shard1 $<TARGET_FILE:prizma-render> "${_fl_scene}|--samples|2:4|-o|dye1.exr|${_small}"
+  MUST_EXIST dye1.exr FIXTURES_SETUP fluorescence_shards)
+prizma_fluorescence_e2e(merge $<TARGET_FILE:prizma-render> "merge|dye0.exr|dye1.exr|-o|dye.exr"
+  MUST_EXIST dye.exr ERR_REGEX "samples 0:4" FIXTURES_REQUIRED fluorescence_shards FIXTURES_SETUP fluorescence_merged)
+prizma_fluorescence_e2e(relight $<TARGET_FILE:prizma-relight> "dye.exr|--light|key=LED-V1|--light|sky=off|-o|dye_violet.png"
+  MUST_EXIST dye_violet.png FIXTURES_REQUIRED fluorescence_merged)
+prizma_fluorescence_e2e(single_refused $<TARGET_FILE:prizma-render>
+  "${_fl_scene}|--wavelength-sampling|single|-o|single.exr|${_small}" EXPECT_RC 2 MUST_NOT_EXIST single.exr
+  ERR_REGEX "wavelength_sampling: fluorescence is rendered with spectral-tracking only" ERR_LINES 1)

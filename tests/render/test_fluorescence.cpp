@@ -1,0 +1,255 @@
+// Fluorescence (issue 16): the scene field, and absolute checks of the bispectral transport against
+// closed forms (docs/fluorescence.md). Every expected value is computed here from the spectra, never
+// from another render. The dye absorbs only in 400–500 nm and emits only in 550–700 nm, so light is
+// re-emitted at most once and the single-event forms below are exact at any optical depth.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <vector>
+
+#include "prizma/render/fluorescence.h"
+#include "prizma/render/render.h"
+#include "prizma/render/scene.h"
+#include "prizma/spectral/spectrum_spec.h"
+#include "prizma/spectral/bispectral.h"
+#include "prizma/spectral/error.h"
+#include "render_test_scenes.h"
+#include "test_scene_util.h"
+
+namespace prizma::render {
+namespace {
+
+using spectral::Spectrum;
+using testing::box_scene;
+using testing::grey_material;
+
+constexpr double kSe = 3.0;  // tolerance in standard errors (fixed seeds)
+constexpr double kPi = std::numbers::pi;
+
+// σf per unit: 2 at 400 nm falling to 0 at 500 nm (zero outside the table).
+Spectrum dye_absorption(double scale) { return Spectrum({400.0, 450.0, 500.0}, {2.0 * scale, 1.0 * scale, 0.0}); }
+// Emission, any scale (the renderer normalises it): zero below 550 nm.
+Spectrum dye_emission() { return Spectrum({550.0, 600.0, 650.0, 700.0}, {0.0, 2.0, 2.0, 1.0}); }
+
+Material dye_material(double sigma_t, double sigma_f_scale, double q) {
+  Material m = grey_material(0.0, sigma_t);  // σt: a non-fluorescent absorber (albedo 0)
+  m.fluorescent = true;
+  m.fluorescence.absorption = dye_absorption(sigma_f_scale);
+  m.fluorescence.emission = dye_emission();
+  m.fluorescence.quantum_yield = q;
+  return m;
+}
+
+// Simpson's rule with many panels (the integrands are smooth inside a bin).
+double integrate(const std::function<double(double)>& f, double a, double b, int n = 2000) {
+  const double h = (b - a) / n;
+  double s = f(a) + f(b);
+  for (int i = 1; i < n; ++i) s += f(a + i * h) * (i % 2 ? 4.0 : 2.0);
+  return s * h / 3.0;
+}
+
+// Mean over pixels of each bispectral pair of a light, and its standard error from the spread over
+// pixels (the box is homogeneous and every pixel's ray crosses it fully: the pixels are i.i.d.).
+struct PairEstimate {
+  std::vector<double> mean, se;
+};
+PairEstimate pair_average(const spectral::SpectralImage& img, int light) {
+  const std::size_t np = img.reradiation.size(), p = img.pixel_count();
+  PairEstimate e{std::vector<double>(np, 0.0), std::vector<double>(np, 0.0)};
+  const auto& r = img.lights[static_cast<std::size_t>(light)].reradiation;
+  for (std::size_t k = 0; k < np; ++k) {
+    double s = 0.0, s2 = 0.0;
+    for (std::size_t px = 0; px < p; ++px) {
+      const double v = r[px * np + k];
+      s += v;
+      s2 += v * v;
+    }
+    const double mean = s / p;
+    e.mean[k] = mean;
+    e.se[k] = std::sqrt(std::max(0.0, (s2 / p - mean * mean) * p / (p - 1.0)) / p);
+  }
+  return e;
+}
+
+// (q/4π)·⟨ρ(λ)/λ⟩_out·∫_in λ·f(σf(λ)) dλ: the single-event bispectral term, ρ the normalised
+// emission, f the geometry's absorbed (and transmitted) fraction as a function of σf.
+double closed_form(const spectral::BinLayout& bins, const spectral::BinPair& pr, double q, double sigma_f_scale,
+                   const std::function<double(double)>& f) {
+  const Spectrum rho = dye_emission().scaled(1.0 / fluorescence_emission_area(dye_emission()));
+  const Spectrum sf = dye_absorption(sigma_f_scale);
+  const double out_avg =
+      integrate([&](double l) { return rho.eval(l) / l; }, bins.lo_nm(pr.out), bins.hi_nm(pr.out)) / bins.width_nm(pr.out);
+  const double in_int = integrate([&](double l) { return l * f(sf.eval(l)); }, bins.lo_nm(pr.in), bins.hi_nm(pr.in));
+  return q / (4.0 * kPi) * out_avg * in_int;
+}
+
+Scene dye_box(const Material& m, Eigen::Vector3d light_dir, std::int64_t spp) {
+  Scene s = box_scene(m, 4, 8, spp);
+  s.lights = {testing::directional_light("uv", light_dir)};
+  return s;
+}
+
+TEST(Fluorescence, LayoutHoldsOnlyTheBinsTheDyeCanFill) {
+  const auto bins = spectral::BinLayout::linear(400, 700, 6);  // 50 nm bins
+  Scene s = dye_box(dye_material(0.0, 1.0, 1.0), {0, 0, 1}, 1);
+  const FluorescenceLayout fl = fluorescence_layout(s.medium, bins);
+  EXPECT_TRUE(fl.any);
+  EXPECT_TRUE(fl.diagonal.empty());
+  const std::vector<spectral::BinPair> want = {{0, 3}, {0, 4}, {0, 5}, {1, 3}, {1, 4}, {1, 5}};
+  EXPECT_EQ(fl.pairs, want);
+  s.medium.materials[0].fluorescence.quantum_yield = 0.0;  // q = 0: nothing is re-emitted
+  EXPECT_FALSE(fluorescence_layout(s.medium, bins).any);
+}
+
+// q = 1 furnace of photons: a box whose only absorber is the dye, lit from the side the camera
+// looks from. Every absorbed photon is re-emitted (isotropically, at λout drawn from ρ) and the
+// red leaves unattenuated, so per output bin M[out][in] = (1/4π)·⟨ρ/λ⟩_out·∫_in λ(1 − e^{−σf}) dλ:
+// the photons absorbed over the depth (1 − e^{−σf}), each carrying energy λin/λout times its own.
+TEST(Fluorescence, QuantumYieldOneConservesPhotonsPerOutputBin) {
+  Scene s = dye_box(dye_material(0.0, 1.0, 1.0), {0, 0, 1}, 256);
+  const spectral::SpectralImage img = render(s);
+  ASSERT_EQ(img.reradiation.size(), 6u);
+  const PairEstimate e = pair_average(img, 0);
+  for (std::size_t k = 0; k < img.reradiation.size(); ++k) {
+    const double want = closed_form(img.bins, img.reradiation[k], 1.0, 1.0, [](double sf) { return 1.0 - std::exp(-sf); });
+    EXPECT_GT(want, 0.0);
+    EXPECT_NEAR(e.mean[k], want, kSe * e.se[k] + 1e-6) << "pair " << k << " se " << e.se[k];
+    EXPECT_LT(e.se[k], 0.03 * want);  // the test can tell a wrong factor (λin/λout is ~0.7–0.8)
+  }
+  // No scattering: the diagonal (the T layer) holds nothing under the directional light.
+  for (float v : img.lights[0].data) EXPECT_EQ(v, 0.0f);
+}
+
+// An optically thin dye slab (σf ≤ 0.2) in an absorbing medium (σt = 0.3), lit from below and seen
+// from above, q = 0.6: light reaches height h with e^{−(σt+σf)h}, the re-emitted red leaves with
+// e^{−σt(1−h)}, so ∫₀¹ σf e^{…} dh = e^{−σt}(1 − e^{−σf}).
+TEST(Fluorescence, ThinSlabUnderDirectionalLightMatchesTheSingleEventForm) {
+  const double st = 0.3, scale = 0.1, q = 0.6;
+  Scene s = dye_box(dye_material(st, scale, q), {0, 0, -1}, 512);
+  const spectral::SpectralImage img = render(s);
+  ASSERT_EQ(img.reradiation.size(), 6u);
+  const PairEstimate e = pair_average(img, 0);
+  for (std::size_t k = 0; k < img.reradiation.size(); ++k) {
+    const double want =
+        closed_form(img.bins, img.reradiation[k], q, scale, [&](double sf) { return std::exp(-st) * (1.0 - std::exp(-sf)); });
+    EXPECT_NEAR(e.mean[k], want, kSe * e.se[k] + 1e-7) << "pair " << k << " se " << e.se[k];
+    EXPECT_LT(e.se[k], 0.1 * want);
+  }
+}
+
+// q = 0: the dye only absorbs; the environment seen through the box is Beer–Lambert with σt + σf
+// (bin averages of e^{−(σt+σf(λ))}), and no bispectral term is written.
+TEST(Fluorescence, QuantumYieldZeroIsBeerLambertWithSigmaTPlusSigmaF) {
+  const double st = 0.5;
+  Scene s = box_scene(dye_material(st, 1.0, 0.0), 4, 8, 256);
+  const spectral::SpectralImage img = render(s);
+  EXPECT_TRUE(img.reradiation.empty());
+  EXPECT_TRUE(img.lights[0].reradiation.empty());
+  const auto e = testing::pixel_average(img, 0);
+  const Spectrum sf = dye_absorption(1.0);
+  for (int i = 0; i < img.bins.size(); ++i) {
+    const double want = integrate([&](double l) { return std::exp(-(st + sf.eval(l))); }, img.bins.lo_nm(i), img.bins.hi_nm(i)) /
+                        img.bins.width_nm(i);
+    EXPECT_NEAR(e.mean[i], want, kSe * e.se[i] + 1e-6) << "bin " << i;
+  }
+  // The estimate must be able to tell σt alone from σt + σf in the dye's bins.
+  EXPECT_LT(e.mean[0], std::exp(-st) - 10.0 * e.se[0]);
+}
+
+// Relighting the bispectral file under E (diagonal T·ē plus Σ_in M[out][in]·ē_in) equals rendering
+// with E folded into the paths. Both lights are constant inside every bin (box spectra on the bin
+// edges), where relighting is exact; the two renders share their random numbers.
+TEST(Fluorescence, RelightingTheBispectralImageEqualsFoldingTheLightIn) {
+  Material m = dye_material(0.2, 1.0, 0.8);
+  m.albedo = Spectrum::constant(0.5);  // scattering too: diagonal and chains through scattering
+  Scene s = box_scene(m, 4, 8, 64);
+  s.lights[0].spectrum_spec = "box:450:650";                        // environment
+  s.lights.push_back(testing::directional_light("uv", {0.3, 0.2, 1}));
+  s.lights[1].spectrum_spec = "box:400:500*2";
+  const spectral::SpectralImage bi = render(s);
+  ASSERT_FALSE(bi.reradiation.empty());
+  s.settings.fold_light_spectra = true;
+  const spectral::SpectralImage folded = render(s);
+  EXPECT_TRUE(folded.reradiation.empty());
+  const int nb = bi.bins.size();
+  std::vector<double> relit(bi.pixel_count() * nb, 0.0);
+  for (int l = 0; l < 2; ++l) {
+    spectral::SpecContext ctx;
+    const std::vector<double> e = spectral::parse_spectrum(s.lights[l].spectrum_spec, ctx).bin_averages(bi.bins);
+    for (std::size_t px = 0; px < bi.pixel_count(); ++px)
+      for (int i = 0; i < nb; ++i) relit[px * nb + i] += bi.lights[l].data[px * nb + i] * e[i];
+    spectral::add_reradiated(bi, l, e, relit);
+  }
+  for (std::size_t px = 0; px < bi.pixel_count(); ++px)
+    for (int i = 0; i < nb; ++i) {
+      double want = 0.0;
+      for (int l = 0; l < 2; ++l) want += folded.lights[l].data[px * nb + i];
+      EXPECT_NEAR(relit[px * nb + i], want, 2e-4 * (1.0 + std::abs(want))) << "pixel " << px << " bin " << i;
+    }
+  double reradiated = 0.0;
+  for (float v : bi.lights[1].reradiation) reradiated += v;
+  EXPECT_GT(reradiated, 0.0);
+  // The violet light shows red only through fluorescence: its relit red bins are not zero.
+  double red = 0.0;
+  for (std::size_t px = 0; px < bi.pixel_count(); ++px) red += folded.lights[1].data[px * nb + 4];
+  EXPECT_GT(red, 0.0);
+}
+
+TEST(Fluorescence, SingleWavelengthSamplingIsRefused) {
+  Scene s = dye_box(dye_material(0.0, 1.0, 1.0), {0, 0, 1}, 1);
+  s.settings.wavelength_sampling = WavelengthSampling::Single;
+  EXPECT_THROW(render(s), spectral::InputError);
+}
+
+// The scene field: the happy path and one-line errors naming the field.
+nlohmann::json dye_scene(const nlohmann::json& fluorescence) {
+  nlohmann::json j = nlohmann::json::parse(R"({
+    "volume": {"type": "procedural", "name": "cube_sphere", "resolution": 8},
+    "materials": [{"name": "dye", "range": [0, 255], "albedo": 0.5, "extinction": 1}],
+    "camera": {"width": 4, "height": 4},
+    "lights": [{"name": "uv", "direction": [0, 0, 1]}],
+    "bins": "linear:400:700:6", "samples": 1
+  })");
+  j["materials"][0]["fluorescence"] = fluorescence;
+  return j;
+}
+
+void expect_field_error(const nlohmann::json& fl, const std::string& field, const std::string& reason) {
+  testing::ScratchDir dir;
+  const auto path = dir.write("scene.json", dye_scene(fl).dump());
+  try {
+    load_scene(path);
+    FAIL() << "no error; expected " << field;
+  } catch (const spectral::InputError& e) {
+    EXPECT_EQ(e.input(), path.string() + ": materials[0].fluorescence" + field) << e.what();
+    EXPECT_NE(e.reason().find(reason), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+}
+
+TEST(Fluorescence, SceneFieldIsReadAndChecked) {
+  testing::ScratchDir dir;
+  const nlohmann::json good = {{"absorption", "box:400:450*3"}, {"emission", "gaussian:600:40"}, {"quantum_yield", 0.9}};
+  const Scene s = load_scene(dir.write("scene.json", dye_scene(good).dump()));
+  ASSERT_TRUE(s.medium.materials[0].fluorescent);
+  EXPECT_DOUBLE_EQ(s.medium.materials[0].fluorescence.quantum_yield, 0.9);
+  EXPECT_NEAR(s.medium.materials[0].fluorescence.absorption.eval(420.0), 3.0, 1e-12);
+  // Without the field the hash is that of the same scene before fluorescence existed.
+  nlohmann::json plain = dye_scene(good);
+  plain["materials"][0].erase("fluorescence");
+  EXPECT_FALSE(load_scene(dir.write("plain.json", plain.dump())).medium.materials[0].fluorescent);
+
+  expect_field_error(1, "", "must be an object");
+  expect_field_error({{"absorption", 1}, {"emission", 1}}, ".quantum_yield", "is required");
+  expect_field_error({{"absorption", 1}, {"emission", 1}, {"quantum_yield", 1.5}}, ".quantum_yield", "must be in [0, 1]");
+  expect_field_error({{"absorption", -1}, {"emission", 1}, {"quantum_yield", 1}}, ".absorption", "must be ≥ 0");
+  expect_field_error({{"absorption", 1}, {"emission", 0}, {"quantum_yield", 1}}, ".emission", "has no area");
+  expect_field_error({{"absorption", 1}, {"emission", "box:900:950"}, {"quantum_yield", 1}}, ".emission", "");
+  expect_field_error({{"absorption", 1}, {"emission", 1}, {"quantum_yield", 1}, {"colour", 1}}, ".colour", "unknown field");
+}
+
+}  // namespace
+}  // namespace prizma::render
