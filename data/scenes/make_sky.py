@@ -2,8 +2,8 @@
 """Writes data/scenes/sky.exr, the environment map of sky_haze.json: a 128 × 64 equirectangular
 (lat-long) luminance image (docs/scene-format.md, "Environment maps"): a sky brighter toward the
 horizon (0.6 at the zenith, 1.0 at the horizon), a dark ground (0.08), and a sun disc of angular
-radius 4° and radiance 150 at 35° elevation toward +x, a little behind the volume (azimuth 60°
-from −z toward +x). One channel, float, ZIP-compressed; deterministic.
+radius 4° and radiance 600 at 25° elevation to the right (+x), a little behind the volume (azimuth
+80° from −z toward +x). One channel, float, ZIP-compressed; deterministic.
     make_sky.py [OUTPUT]   (default: sky.exr next to this script)"""
 import math
 import os
@@ -24,9 +24,9 @@ d = np.stack([np.sin(theta) * np.sin(phi), np.cos(theta) * np.ones_like(phi), -n
 
 elevation = np.pi / 2 - theta
 sky = np.where(elevation > 0, 1.0 - 0.4 * np.sin(elevation), 0.08) * np.ones_like(phi)
-sun_el, sun_az = math.radians(35.0), math.radians(60.0)
+sun_el, sun_az = math.radians(25.0), math.radians(80.0)
 sun = np.array([math.cos(sun_el) * math.sin(sun_az), math.sin(sun_el), -math.cos(sun_el) * math.cos(sun_az)])
-sky = np.where(d @ sun > math.cos(math.radians(4.0)), 150.0, sky).astype(np.float32)
+sky = np.where(d @ sun > math.cos(math.radians(4.0)), 600.0, sky).astype(np.float32)
 
 spec = oiio.ImageSpec(W, H, 1, oiio.FLOAT)
 spec.channelnames = ("Y",)
