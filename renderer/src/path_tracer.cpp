@@ -20,6 +20,7 @@ constexpr float kTransmittanceRrStop = 0.75f;
 // ends in bounded time.
 constexpr std::int64_t kMaxPathSteps = std::int64_t{1} << 28;
 constexpr float kAbandoned = std::numeric_limits<float>::quiet_NaN();
+constexpr double kFloatMax = std::numeric_limits<float>::max();
 
 // Lanes known at compile time (1) or not (0 = scratch.lanes).
 template <int kLanes>
@@ -401,7 +402,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
         const float p = hg_phase(cos_theta, g[0]);
         double k = ls.value;
         if (ls.pdf > 0.0) k *= power_heuristic(ls.pdf, p);
-        const auto kp = static_cast<float>(k) * p;
+        const auto kp = static_cast<float>(std::min(k, kFloatMax)) * p;  // 1/r² of a light at the vertex
         for (int i = 0; i < n; ++i) out[i] += w[i] * kp * T[i];
       } else {
         for (int i = 0; i < n; ++i) f[i] = hg_phase(cos_theta, g[i]);
@@ -414,7 +415,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
           }
           k *= total > 0.0f ? power_heuristic(ls.pdf, mix / total) : 0.0;
         }
-        const auto kf = static_cast<float>(k);
+        const auto kf = static_cast<float>(std::min(k, kFloatMax));
         for (int i = 0; i < n; ++i) out[i] += w[i] * kf * f[i] * T[i];
       }
     }
