@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "prizma/render/light_sampler.h"
 #include "prizma/render/render.h"
 #include "prizma/render/resume.h"
 #include "prizma/render/sample_range.h"
@@ -307,8 +308,8 @@ int main(int argc, char** argv) {
                 << st.seed << ", " << render::wavelength_sampling_name(st.wavelength_sampling)
                 << (st.use_majorant_grid ? ", majorant grid" : ", global majorant") << "\n";
       for (const auto& l : scene.lights)
-        std::cerr << kProgram << ": light " << l.name << " direction (" << l.direction.transpose()
-                  << ") angular size " << l.angular_size_deg << "° default spectrum " << l.spectrum_spec << "\n";
+        std::cerr << kProgram << ": light " << l.name << ": " << render::describe_light(l) << ", default spectrum "
+                  << l.spectrum_spec << "\n";
     }
 
     catch_interruptions();

@@ -42,6 +42,19 @@ std::string lights_to_json(const std::vector<Light>& lights) {
                    {"angularSizeDeg", l.angular_size_deg},
                    {"spectrum", l.spectrum_spec}});
     if (l.emission) arr.back()["emission"] = true;  // only then: files without emission unchanged
+    if (l.is_point) {  // point, sphere and spot lights (only then, as emission)
+      auto& j = arr.back();
+      j["position"] = {l.position.x(), l.position.y(), l.position.z()};
+      if (l.radius > 0.0) j["radius"] = l.radius;
+      if (l.spot_direction.squaredNorm() > 0.0)
+        j["spot"] = {{"direction", {l.spot_direction.x(), l.spot_direction.y(), l.spot_direction.z()}},
+                     {"coneDeg", l.spot_cone_deg},
+                     {"falloffDeg", l.spot_falloff_deg}};
+    }
+    if (l.environment_map) {
+      arr.back()["environment"] = l.environment_file;
+      arr.back()["rotationDeg"] = l.rotation_deg;
+    }
   }
   return arr.dump();
 }

@@ -12,7 +12,6 @@
 namespace prizma::render {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Ratio tracking's Russian roulette: below this largest transmittance, stop with probability kRrStop.
 constexpr float kTransmittanceRrThreshold = 0.05f;
 constexpr float kTransmittanceRrStop = 0.75f;
@@ -22,6 +21,7 @@ constexpr float kTransmittanceRrStop = 0.75f;
 // ends in bounded time.
 constexpr std::int64_t kMaxPathSteps = std::int64_t{1} << 28;
 constexpr float kAbandoned = std::numeric_limits<float>::quiet_NaN();
+constexpr double kFloatMax = std::numeric_limits<float>::max();
 
 // Lanes known at compile time (1) or not (0 = scratch.lanes).
 template <int kLanes>
@@ -98,11 +98,10 @@ PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi
       m_emission_light = static_cast<int>(l);
       continue;
     }
-    if (light.direction.squaredNorm() == 0.0) continue;
-    DirectionalLight d;
-    d.direction = light.direction.normalized();
-    d.cos_max = light.angular_size_deg > 0 ? std::cos(0.5 * light.angular_size_deg * kPi / 180.0) : 1.0;
-    m_lights.push_back(d);
+    if (light.direction.squaredNorm() == 0.0 && !light.is_point && !light.environment_map) continue;
+    m_lights.emplace_back(light);
+    if (m_lights.back().seen_by_escapes()) m_escape_lights.push_back(static_cast<int>(m_lights.size()) - 1);
+    m_any_mis = m_any_mis || m_lights.back().mis();
     m_directional_index.push_back(static_cast<int>(l));
   }
   if (m_any_emission && m_emission_light < 0)
@@ -273,9 +272,19 @@ void PathTracer::trace(const Ray& ray, Rng& rng, PathScratch& s) const {
     trace_lanes<0>(ray, rng, s);
 }
 
+void PathTracer::add_escape(const Eigen::Vector3d& dir, double phase_pdf, const float* w, PathScratch& s) const {
+  const int n = s.lanes;
+  for (int k : m_escape_lights) {
+    const auto radiance = static_cast<float>(m_lights[k].escape_radiance(dir, phase_pdf));
+    if (!(radiance > 0.0f)) continue;
+    float* __restrict out = s.directional.data() + static_cast<std::size_t>(k) * n;
+    for (int i = 0; i < n; ++i) out[i] += w[i] * radiance;
+  }
+}
+
 template <int kLanes>
 void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng,
-                               PathScratch& s) const {
+                               PathScratch& s, double t_max) const {
   // Ratio tracking (Novák, Selle, Jarosz 2014) against the cell majorants, every lane at once:
   // T *= 1 − σt/μ̄ at each tentative collision, with Russian roulette once T is small.
   const int n = lane_count<kLanes>(s);
@@ -284,6 +293,8 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
   const Ray ray{origin, dir};
   double t_enter, t_exit;
   if (!intersect_box(ray, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) return;
+  t_exit = std::min(t_exit, t_max);  // a light inside or before the box: only the medium up to it
+  if (!(t_exit > t_enter)) return;
   MajorantTraversal walk(m_grid, ray, t_enter, t_exit);
   MajorantTraversal::Segment seg;
   const std::int64_t step_limit = s.counters.shadow_steps + kMaxPathSteps;
@@ -355,8 +366,10 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   double t_enter, t_exit;
   if (!intersect_box(camera_ray, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) {
     for (int i = 0; i < n; ++i) env[i] = 1.0f;
+    add_escape(dir, 0.0, w, s);
     return;
   }
+  double phase_pdf = 0.0;  // density of dir's last draw from the phase function (0: camera ray)
   ++s.counters.paths_in_volume;
   int bounces = 0;
   const std::int64_t step_limit = s.counters.collisions + s.counters.shadow_steps + kMaxPathSteps;
@@ -450,8 +463,9 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
       }
     }
     if (!scattered) {
-      // Escaped: the unit environment is seen with the path's weight.
+      // Escaped: the unit environment (and the environment maps) seen with the path's weight.
       for (int i = 0; i < n; ++i) env[i] += w[i];
+      add_escape(dir, phase_pdf, w, s);
       return;
     }
     if (m_max_bounces >= 0 && bounces >= m_max_bounces) return;
@@ -460,25 +474,38 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     const float* __restrict g = isotropic ? s.zero_g.data() : s.g.data() + static_cast<std::size_t>(material) * n;
     const bool g_constant = kLanes == 1 || isotropic || m_g_constant[material];
 
-    // Next-event estimation of every directional light: direction (delta, or uniform in the cone
-    // with radiance 1/Ω, so the estimate is phase × transmittance either way), transmittance by
-    // ratio tracking to the box's exit.
+    // Next-event estimation of every light with its own layer (LightSampler: a direction toward
+    // the light and its radiance / density), transmittance by ratio tracking up to the light (the
+    // box's exit for distant lights). Environment maps weight the sample by the power heuristic
+    // against the density q(ω) the phase sampling below draws ω with (q = Σ_j w_j p_j / Σ_j w_j
+    // when g varies across lanes); their escaping paths carry the complementary weight.
     for (std::size_t l = 0; l < m_lights.size(); ++l) {
-      const DirectionalLight& light = m_lights[l];
-      Eigen::Vector3d wl = light.direction;
-      if (light.cos_max < 1.0) {
-        const double cos_t = 1.0 - rng.uniform_double() * (1.0 - light.cos_max);
-        wl = direction_around(light.direction, cos_t, rng.uniform_double());
-      }
+      LightSample ls;
+      if (!m_lights[l].sample(pos, rng, ls)) continue;
+      const Eigen::Vector3d& wl = ls.direction;
       const auto cos_theta = static_cast<float>(dir.dot(wl));
-      transmittance<kLanes>(pos, wl, rng, s);
+      transmittance<kLanes>(pos, wl, rng, s, ls.distance);
       const float* __restrict T = s.transmittance.data();
       float* __restrict out = dir_out + l * static_cast<std::size_t>(n);
       if (g_constant) {
         const float p = hg_phase(cos_theta, g[0]);
-        for (int i = 0; i < n; ++i) out[i] += w[i] * p * T[i];
+        double k = ls.value;
+        if (ls.pdf > 0.0) k *= power_heuristic(ls.pdf, p);
+        const auto kp = static_cast<float>(std::min(k, kFloatMax)) * p;  // 1/r² of a light at the vertex
+        for (int i = 0; i < n; ++i) out[i] += w[i] * kp * T[i];
       } else {
-        for (int i = 0; i < n; ++i) out[i] += w[i] * hg_phase(cos_theta, g[i]) * T[i];
+        for (int i = 0; i < n; ++i) f[i] = hg_phase(cos_theta, g[i]);
+        double k = ls.value;
+        if (ls.pdf > 0.0) {
+          float total = 0.0f, mix = 0.0f;
+          for (int i = 0; i < n; ++i) {
+            total += w[i];
+            mix += w[i] * f[i];
+          }
+          k *= total > 0.0f ? power_heuristic(ls.pdf, mix / total) : 0.0;
+        }
+        const auto kf = static_cast<float>(std::min(k, kFloatMax));
+        for (int i = 0; i < n; ++i) out[i] += w[i] * kf * f[i] * T[i];
       }
     }
 
@@ -496,6 +523,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     float cos_theta;
     if (g_constant) {
       cos_theta = hg_sample_cos(g[0], rng.uniform());
+      if (m_any_mis) phase_pdf = hg_phase(cos_theta, g[0]);
     } else {
       float total = 0.0f;
       for (int i = 0; i < n; ++i) total += w[i];
@@ -513,6 +541,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
         mix += w[i] * f[i];
       }
       if (!(mix > 0.0f)) return;
+      phase_pdf = mix / total;
       const float k = total / mix;
       for (int i = 0; i < n; ++i) w[i] *= f[i] * k;
     }
@@ -530,6 +559,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     const Ray next{pos, dir};
     if (!intersect_box(next, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) {
       for (int i = 0; i < n; ++i) env[i] += w[i];
+      add_escape(dir, phase_pdf, w, s);
       return;
     }
   }

@@ -38,6 +38,8 @@ constexpr std::int64_t kMaxSamples = std::int64_t{1} << 40;
 constexpr std::int64_t kMaxBounces = 1000000;
 constexpr double kMaxDensity = 1e30;
 constexpr double kMaxExtinctionPerUnit = 1e6;
+// Point-light positions and radii: |coordinate| ≤ this (the volume's largest side is 1 unit).
+constexpr double kMaxLightCoordinate = 1e6;
 
 std::string num(double v) {
   std::ostringstream s;
@@ -509,6 +511,69 @@ void check_light_name(const Reader& rd, const std::string& name, const std::stri
   }
 }
 
+// A point, sphere or spot light ("position") or an environment map ("environment"), with their
+// fields (docs/scene-format.md, "Point, sphere and spot lights", "Environment maps").
+void read_point_or_environment_light(const Reader& rd, const json& lj, const std::string& lp, Light& l) {
+  const bool point = lj.contains("position");
+  const std::string other = point ? "position" : "environment";
+  for (const char* key : {"direction", "angular_size_deg"})
+    if (lj.contains(key)) rd.fail(Reader::join(lp, key), "does not apply to a light with " + other + " (a light has one of direction, position and environment)");
+  if (point) {
+    if (lj.contains("environment")) rd.fail(Reader::join(lp, "environment"), "does not apply to a light with position (a light has one of direction, position and environment)");
+    if (lj.contains("rotation_deg")) rd.fail(Reader::join(lp, "rotation_deg"), "applies to environment-map lights only (this light has a position)");
+    const std::string pp = Reader::join(lp, "position");
+    const auto p = rd.vec3(lj.at("position"), pp);
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(p[a]) > kMaxLightCoordinate)
+        rd.fail(Reader::index(pp, a), "must be in [-" + num(kMaxLightCoordinate) + ", " + num(kMaxLightCoordinate) + "] (got " + num(p[a]) + ")");
+    l.is_point = true;
+    l.position = Eigen::Vector3d(p[0], p[1], p[2]);
+    if (lj.contains("radius")) {
+      const std::string rp = Reader::join(lp, "radius");
+      l.radius = rd.number(lj.at("radius"), rp);
+      if (!(l.radius >= 0.0 && l.radius <= kMaxLightCoordinate))
+        rd.fail(rp, "must be in [0, " + num(kMaxLightCoordinate) + "] (got " + num(l.radius) + ")");
+    }
+    if (lj.contains("spot")) {
+      const std::string sp = Reader::join(lp, "spot");
+      const json& sj = lj.at("spot");
+      rd.expect_object(sj, sp, {"direction", "cone_deg", "falloff_deg"});
+      if (l.radius > 0.0) rd.fail(sp, "a spot light is a point: give radius 0 or no spot");
+      const std::string sdp = Reader::join(sp, "direction");
+      if (!sj.contains("direction")) rd.fail(sdp, "is required (the spot's axis, away from the light)");
+      const auto d = rd.vec3(sj.at("direction"), sdp);
+      Eigen::Vector3d axis(d[0], d[1], d[2]);
+      const double largest = axis.cwiseAbs().maxCoeff();
+      if (!(largest > 0.0)) rd.fail(sdp, "must not be [0, 0, 0]");
+      axis /= largest;
+      l.spot_direction = axis.normalized();
+      const std::string cp = Reader::join(sp, "cone_deg");
+      if (!sj.contains("cone_deg")) rd.fail(cp, "is required (half-angle of the cone, degrees)");
+      l.spot_cone_deg = rd.number(sj.at("cone_deg"), cp);
+      if (!(l.spot_cone_deg > 0.0 && l.spot_cone_deg <= 180.0))
+        rd.fail(cp, "must be in (0, 180] (got " + num(l.spot_cone_deg) + ")");
+      if (sj.contains("falloff_deg")) {
+        const std::string fp = Reader::join(sp, "falloff_deg");
+        l.spot_falloff_deg = rd.number(sj.at("falloff_deg"), fp);
+        if (!(l.spot_falloff_deg >= 0.0 && l.spot_falloff_deg <= l.spot_cone_deg))
+          rd.fail(fp, "must be in [0, cone_deg] = [0, " + num(l.spot_cone_deg) + "] (got " + num(l.spot_falloff_deg) + ")");
+      }
+    }
+    return;
+  }
+  for (const char* key : {"radius", "spot"})
+    if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to point lights only (this light is an environment map)");
+  const std::string ep = Reader::join(lp, "environment");
+  if (lj.contains("rotation_deg")) {
+    const std::string rp = Reader::join(lp, "rotation_deg");
+    l.rotation_deg = rd.number(lj.at("rotation_deg"), rp);
+    if (!(std::abs(l.rotation_deg) <= 360.0)) rd.fail(rp, "must be in [-360, 360] (got " + num(l.rotation_deg) + ")");
+  }
+  l.environment_file = rd.string(lj.at("environment"), ep);
+  l.environment_map = std::make_shared<const EnvironmentMap>(
+      EnvironmentMap::load(rd.file_path(lj.at("environment"), ep), l.rotation_deg, rd.input(ep)));
+}
+
 std::vector<Light> read_lights(const Reader& rd, const json& j) {
   const std::string path = "lights";
   if (!j.is_array()) rd.fail(path, "must be an array of lights (got " + Reader::describe(j) + ")");
@@ -518,7 +583,8 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
   for (std::size_t i = 0; i < j.size(); ++i) {
     const std::string lp = Reader::index(path, i);
     const json& lj = j[i];
-    rd.expect_object(lj, lp, {"name", "direction", "spectrum", "angular_size_deg"});
+    rd.expect_object(lj, lp, {"name", "direction", "spectrum", "angular_size_deg", "position", "radius", "spot",
+                              "environment", "rotation_deg"});
     Light l;
     const std::string np = Reader::join(lp, "name");
     if (!lj.contains("name")) rd.fail(np, "is required");
@@ -534,24 +600,32 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
     spectral::check_exr_light_name(l.name, rd.input(np));  // "var" names the variance layers
     if (!names.insert(l.name).second) rd.fail(np, "duplicate light name \"" + l.name + "\"");
     const std::string dp = Reader::join(lp, "direction");
-    if (!lj.contains("direction")) rd.fail(dp, "is required ([0, 0, 0] = uniform environment)");
-    const auto d = rd.vec3(lj.at("direction"), dp);
-    l.direction = Eigen::Vector3d(d[0], d[1], d[2]);
-    // Only the exact zero vector is the environment: scale by the largest component first, so
-    // that a length of 1e-200 (norm underflows to 0) or 1e200 (overflows) keeps its direction.
-    if (const double largest = l.direction.cwiseAbs().maxCoeff(); largest > 0.0) {
-      l.direction /= largest;
-      l.direction.normalize();
-    }
-    if (lj.contains("angular_size_deg")) {
-      const std::string ap = Reader::join(lp, "angular_size_deg");
-      l.angular_size_deg = rd.number(lj.at("angular_size_deg"), ap);
-      if (!(l.angular_size_deg >= 0.0 && l.angular_size_deg < 180.0)) {
-        rd.fail(ap, "must be in [0, 180) (got " + num(l.angular_size_deg) + ")");
+    if (lj.contains("position") || lj.contains("environment")) {
+      read_point_or_environment_light(rd, lj, lp, l);
+    } else {
+      if (!lj.contains("direction")) rd.fail(dp, "is required ([0, 0, 0] = uniform environment)");
+      const auto d = rd.vec3(lj.at("direction"), dp);
+      l.direction = Eigen::Vector3d(d[0], d[1], d[2]);
+      // Only the exact zero vector is the environment: scale by the largest component first, so
+      // that a length of 1e-200 (norm underflows to 0) or 1e200 (overflows) keeps its direction.
+      if (const double largest = l.direction.cwiseAbs().maxCoeff(); largest > 0.0) {
+        l.direction /= largest;
+        l.direction.normalize();
       }
-      if (l.angular_size_deg > 0.0 && l.direction.norm() == 0.0) {
-        rd.fail(ap, "applies to directional lights only (this light is the environment)");
+      if (lj.contains("angular_size_deg")) {
+        const std::string ap = Reader::join(lp, "angular_size_deg");
+        l.angular_size_deg = rd.number(lj.at("angular_size_deg"), ap);
+        if (!(l.angular_size_deg >= 0.0 && l.angular_size_deg < 180.0)) {
+          rd.fail(ap, "must be in [0, 180) (got " + num(l.angular_size_deg) + ")");
+        }
+        if (l.angular_size_deg > 0.0 && l.direction.norm() == 0.0) {
+          rd.fail(ap, "applies to directional lights only (this light is the environment)");
+        }
       }
+      for (const char* key : {"radius", "spot"})
+        if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to point lights only (give position, not direction)");
+      if (lj.contains("rotation_deg"))
+        rd.fail(Reader::join(lp, "rotation_deg"), "applies to environment-map lights only (give environment, not direction)");
     }
     if (lj.contains("spectrum")) {
       const std::string sp = Reader::join(lp, "spectrum");
@@ -893,6 +967,8 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverr
       h.add(&m.fluorescence.quantum_yield, sizeof m.fluorescence.quantum_yield);
     }
   }
+  for (const Light& l : scene.lights)  // environment images (the scene text holds only their names)
+    if (l.environment_map) h.add(l.environment_map->values().data(), l.environment_map->values().size() * sizeof(float));
   scene.hash = h.hex();
   return scene;
 }

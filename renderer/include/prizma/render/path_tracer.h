@@ -7,9 +7,11 @@
 // radiance the medium emits (the emission light).
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "prizma/render/camera.h"
+#include "prizma/render/light_sampler.h"
 #include "prizma/render/majorant_grid.h"
 #include "prizma/render/rng.h"
 #include "prizma/render/scene.h"
@@ -39,7 +41,7 @@ struct PathScratch {
   std::vector<float> phase;         // [lanes]
   std::vector<float> sigma_a, sigma_s, sigma_n;  // [lanes] at the current collision
   std::vector<float> environment;   // [lanes] result: radiance from the unit environment
-  std::vector<float> directional;   // [directional light][lanes] result
+  std::vector<float> directional;   // [light with its own layer: directional_lights()][lanes] result
   std::vector<float> emission;      // [lanes] result: radiance emitted by the medium (the emission light)
   // Fluorescence (docs/fluorescence.md; sized only when a material fluoresces). The caller sets
   // lo_nm and width_nm (each lane's bin; width 0 = the lane takes no part in fluorescence). A
@@ -75,7 +77,9 @@ class PathTracer {
 
   // True when the ray meets the medium's box (a miss sees only the environment).
   bool hits_medium(const Ray& ray) const;
-  // Directional (non-environment) lights, in scene order: their indices in scene.lights.
+  // Lights with their own result in scratch.directional (directional, point, sphere, spot and
+  // environment-map lights; not the uniform environment nor emission), in scene order: their
+  // indices in scene.lights.
   const std::vector<int>& directional_lights() const { return m_directional_index; }
   const MajorantGrid& grid() const { return m_grid; }
   // Index in scene.lights of the emission light (Light::emission), or −1.
@@ -89,14 +93,14 @@ class PathTracer {
   bool any_fluorescence() const { return m_any_fluorescence; }
 
  private:
-  struct DirectionalLight {
-    Eigen::Vector3d direction;  // unit, toward the light
-    double cos_max = 1.0;       // cone half-angle cosine; 1 = delta
-  };
   template <int kLanes>
   void trace_lanes(const Ray& ray, Rng& rng, PathScratch& s) const;
   template <int kLanes>
-  void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s) const;
+  void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s,
+                     double t_max = std::numeric_limits<double>::infinity()) const;
+  // A path leaving the medium along dir: the environment maps' radiance, MIS-weighted against NEE
+  // by the density phase_pdf its direction was drawn with (0 = a camera ray), times the weights.
+  void add_escape(const Eigen::Vector3d& dir, double phase_pdf, const float* w, PathScratch& s) const;
   void evaluate_material(int m, PathScratch& s) const;
   void evaluate_fluorescence(int m, PathScratch& s) const;
   void fluoresce(int m, float density, float k, Rng& rng, PathScratch& s) const;
@@ -107,7 +111,9 @@ class PathTracer {
   const Medium* m_medium;
   MajorantGrid m_grid;
   Eigen::Vector3d m_inv_voxel;
-  std::vector<DirectionalLight> m_lights;
+  std::vector<LightSampler> m_lights;
+  std::vector<int> m_escape_lights;  // indices in m_lights of the environment maps
+  bool m_any_mis = false;            // some light's NEE is MIS-weighted against phase sampling
   std::vector<int> m_directional_index;
   std::vector<char> m_g_constant;  // per material
   std::vector<char> m_emits;       // per material: emission > 0 somewhere

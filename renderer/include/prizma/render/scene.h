@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "prizma/render/environment_map.h"
 #include "prizma/render/material_rule.h"
 #include "prizma/spectral/bin_layout.h"
 #include "prizma/spectral/spectrum.h"
@@ -69,6 +71,23 @@ struct Light {
   // The emission layer: the radiance emitted by the medium's materials (Material::emission) at unit
   // white; direction and angular size unused. At most one per scene.
   bool emission = false;
+  // Point, sphere and spot lights (docs/scene-format.md, "Point, sphere and spot lights"): unit
+  // radiant intensity at unit white (1 W/sr on the axis of a spot), direction unused.
+  bool is_point = false;
+  Eigen::Vector3d position{0, 0, 0};
+  double radius = 0.0;                         // > 0: a sphere of the same total power (4π), ≥ 0
+  Eigen::Vector3d spot_direction{0, 0, 0};     // unit spot axis; zero = not a spot
+  double spot_cone_deg = 0.0;                  // spot: half-angle where the intensity reaches 0, (0, 180]
+  double spot_falloff_deg = 0.0;               // spot: width of the smooth edge inside the cone, [0, cone]
+  // Environment-map light: the lat-long image's luminance as radiance (docs/scene-format.md).
+  std::shared_ptr<const EnvironmentMap> environment_map;
+  std::string environment_file;                // as given in the scene (for the render's metadata)
+  double rotation_deg = 0.0;
+  // How an environment map is sampled: Auto = next-event estimation and phase sampling combined by
+  // MIS, or phase sampling alone when the image is constant (exactly the uniform environment's
+  // estimator); Mis and PhaseOnly force one (tests).
+  enum class EnvironmentSampling { Auto, Mis, PhaseOnly };
+  EnvironmentSampling environment_sampling = EnvironmentSampling::Auto;
 };
 
 enum class CameraType { Perspective, Orthographic };

@@ -1,0 +1,212 @@
+// EnvironmentMap: lat-long radiance image, its piecewise-constant 2D sampling distribution, and
+// reading it with OpenImageIO.
+#include "prizma/render/environment_map.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
+#include "prizma/spectral/stderr_capture.h"
+
+namespace prizma::render {
+
+using spectral::InputError;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Environment images: at most 2^25 pixels (8192 × 4096), and at most this many decoded bytes per
+// byte of file, so that a tiny file claiming a huge image is refused before anything is allocated.
+constexpr long long kMaxEnvironmentPixels = 1LL << 25;
+constexpr long long kMaxEnvironmentExpansion = 4096;
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+// The last error OpenImageIO holds (the reader's, else the global one), on one line; clearing both.
+std::string oiio_error(OIIO::ImageInput* in) {
+  std::string e = in != nullptr ? in->geterror() : std::string();
+  const std::string global = OIIO::geterror();
+  if (e.empty()) e = global;
+  for (char& c : e)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!e.empty() && e.back() == ' ') e.pop_back();
+  return e.empty() ? "unknown error" : e;
+}
+
+// Index of the interval of a CDF (size n + 1, cdf[0] = 0, cdf[n] = total) that holds x.
+std::size_t find_interval(const double* cdf, std::size_t n, double x) {
+  const double* it = std::upper_bound(cdf, cdf + n + 1, x);
+  const auto i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(it - cdf - 1, 0));
+  return std::min(i, n - 1);
+}
+
+}  // namespace
+
+EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> values, double rotation_deg,
+                               const std::string& input)
+    : m_width(width), m_height(height), m_values(std::move(values)) {
+  if (width < 1 || height < 1) throw InputError(input, "image is empty");
+  const std::size_t n = static_cast<std::size_t>(width) * height;
+  if (m_values.size() != n) throw InputError(input, "image has " + std::to_string(m_values.size()) + " values for " +
+                                                        std::to_string(width) + "×" + std::to_string(height) + " pixels");
+  if (!std::isfinite(rotation_deg)) throw InputError(input, "rotation must be finite");
+  double peak = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float v = m_values[i];
+    const std::string where = "pixel (" + std::to_string(i % width) + ", " + std::to_string(i / width) + ")";
+    if (!std::isfinite(v)) throw InputError(input, where + " is not finite (" + num(v) + ")");
+    if (v < 0.0f) throw InputError(input, where + " is negative (" + num(v) + ")");
+    peak = std::max(peak, static_cast<double>(v));
+  }
+  if (!(peak > 0.0)) throw InputError(input, "every pixel is 0 (the light would send nothing)");
+  m_constant = std::all_of(m_values.begin(), m_values.end(), [&](float v) { return v == m_values.front(); });
+  const double r = rotation_deg * kPi / 180.0;
+  m_cos_rot = std::cos(r);
+  m_sin_rot = std::sin(r);
+
+  // Row marginal ∝ Σ_x L(x, y) sin θ_y and per-row conditionals ∝ L(x, y) (cumulative, in double).
+  m_row_cdf.assign(static_cast<std::size_t>(height) + 1, 0.0);
+  m_col_cdf.assign(static_cast<std::size_t>(height) * (width + 1), 0.0);
+  for (int y = 0; y < height; ++y) {
+    double* c = m_col_cdf.data() + static_cast<std::size_t>(y) * (width + 1);
+    for (int x = 0; x < width; ++x) c[x + 1] = c[x] + m_values[static_cast<std::size_t>(y) * width + x];
+    const double sin_theta = std::sin(kPi * (y + 0.5) / height);
+    m_row_cdf[y + 1] = m_row_cdf[y] + c[width] * sin_theta;
+  }
+  m_integral = m_row_cdf[height] / (static_cast<double>(width) * height);
+}
+
+EnvironmentMap EnvironmentMap::load(const std::filesystem::path& path, double rotation_deg, const std::string& input) {
+  const std::string file = path.string();
+  try {
+    spectral::require_regular_file(path, "an environment image");
+  } catch (const InputError& e) {
+    throw InputError(input, std::string("image ") + e.what());
+  }
+  std::error_code ec;
+  const auto file_bytes = static_cast<long long>(std::filesystem::file_size(path, ec));
+  // libpng and OpenEXR may print their errors on stderr first: captured into the one line.
+  spectral::StderrCapture open_capture;
+  auto in = OIIO::ImageInput::open(file);
+  const std::string open_printed = open_capture.finish();
+  if (!in) {
+    const std::string e = oiio_error(nullptr);
+    throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("image library", open_printed, e));
+  }
+  const OIIO::ImageSpec spec = in->spec();
+  const int w = spec.width, h = spec.height, nc = spec.nchannels;
+  if (w < 1 || h < 1 || nc < 1) throw InputError(input, "image " + file + " is empty");
+  const long long pixels = static_cast<long long>(w) * h;
+  if (pixels > kMaxEnvironmentPixels) {
+    throw InputError(input, "image " + file + " is " + std::to_string(w) + "×" + std::to_string(h) +
+                                " pixels; an environment map has at most " + std::to_string(kMaxEnvironmentPixels) +
+                                " pixels");
+  }
+  const long long decoded = pixels * nc * static_cast<long long>(spec.format.size());
+  if (ec || decoded > kMaxEnvironmentExpansion * std::max(file_bytes, 1LL)) {
+    throw InputError(input, "image " + file + " claims " + std::to_string(w) + "×" + std::to_string(h) + "×" +
+                                std::to_string(nc) + " pixels, more than its " + std::to_string(file_bytes) +
+                                " bytes can hold (truncated or corrupt)");
+  }
+  const int channels = std::min(nc, 3);
+  std::vector<float> px(static_cast<std::size_t>(pixels) * channels);
+  spectral::StderrCapture read_capture;
+  const bool read_ok = in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, px.data());
+  const std::string read_printed = read_capture.finish();
+  if (!read_ok) {
+    const std::string e = oiio_error(in.get());
+    throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("image library", read_printed, e));
+  }
+  in->close();
+  std::vector<float> lum(static_cast<std::size_t>(pixels));
+  for (std::size_t i = 0; i < lum.size(); ++i) {
+    const float* p = px.data() + i * channels;
+    if (channels < 3) {
+      lum[i] = p[0];
+    } else {
+      // A non-finite or negative channel is reported as such, not hidden in the sum.
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(p[c]) || p[c] < 0.0f)
+          throw InputError(input, "image " + file + ": pixel (" + std::to_string(i % w) + ", " + std::to_string(i / w) +
+                                      ") channel " + "RGB"[c] + " = " + num(p[c]) + " (must be finite and ≥ 0)");
+      lum[i] = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2];
+    }
+  }
+  try {
+    return EnvironmentMap(w, h, std::move(lum), rotation_deg, input);
+  } catch (const InputError& e) {
+    throw InputError(input, "image " + file + ": " + e.reason());  // names the file, as the reader's errors do
+  }
+}
+
+void EnvironmentMap::to_uv(const Eigen::Vector3d& d, double& u, double& v) const {
+  // Scene → map space: rotate by −rotation about +y.
+  const double x = m_cos_rot * d.x() - m_sin_rot * d.z();
+  const double z = m_sin_rot * d.x() + m_cos_rot * d.z();
+  v = std::acos(std::clamp(d.y(), -1.0, 1.0)) / kPi;
+  u = std::atan2(x, -z) / (2.0 * kPi) + 0.5;
+}
+
+Eigen::Vector3d EnvironmentMap::from_uv(double u, double v) const {
+  const double theta = kPi * v, phi = 2.0 * kPi * (u - 0.5);
+  const double st = std::sin(theta);
+  const double x = st * std::sin(phi), y = std::cos(theta), z = -st * std::cos(phi);
+  // Map → scene space: rotate by +rotation about +y.
+  return {m_cos_rot * x + m_sin_rot * z, y, -m_sin_rot * x + m_cos_rot * z};
+}
+
+std::size_t EnvironmentMap::pixel_at(double u, double v) const {
+  const int x = std::clamp(static_cast<int>(u * m_width), 0, m_width - 1);
+  const int y = std::clamp(static_cast<int>(v * m_height), 0, m_height - 1);
+  return static_cast<std::size_t>(y) * m_width + x;
+}
+
+double EnvironmentMap::radiance(const Eigen::Vector3d& dir) const {
+  if (m_constant) return m_values.front();
+  double u, v;
+  to_uv(dir, u, v);
+  return m_values[pixel_at(u, v)];
+}
+
+double EnvironmentMap::sample(double u0, double u1, Eigen::Vector3d& dir, double& radiance) const {
+  // Row from the marginal, column from the row's conditional, uniform within the pixel.
+  const double row_target = u1 * m_row_cdf[m_height];
+  const std::size_t y = find_interval(m_row_cdf.data(), static_cast<std::size_t>(m_height), row_target);
+  const double row_w = m_row_cdf[y + 1] - m_row_cdf[y];
+  const double fy = row_w > 0.0 ? std::clamp((row_target - m_row_cdf[y]) / row_w, 0.0, 1.0) : 0.5;
+  const double* c = m_col_cdf.data() + y * (static_cast<std::size_t>(m_width) + 1);
+  const double col_target = u0 * c[m_width];
+  const std::size_t x = find_interval(c, static_cast<std::size_t>(m_width), col_target);
+  const double col_w = c[x + 1] - c[x];
+  const double fx = col_w > 0.0 ? std::clamp((col_target - c[x]) / col_w, 0.0, 1.0) : 0.5;
+  const double u = (static_cast<double>(x) + fx) / m_width, v = (static_cast<double>(y) + fy) / m_height;
+  dir = from_uv(u, v);
+  radiance = m_values[y * static_cast<std::size_t>(m_width) + x];
+  const double sin_theta = std::sin(kPi * v);
+  if (!(sin_theta > 0.0)) return 0.0;
+  // p(u, v) = L sin θ_y / ∫∫ L sin θ_y du dv; dω = 2π² sin θ du dv.
+  const double sin_row = std::sin(kPi * (static_cast<double>(y) + 0.5) / m_height);
+  const double p_uv = radiance * sin_row / m_integral;
+  return p_uv / (2.0 * kPi * kPi * sin_theta);
+}
+
+double EnvironmentMap::pdf(const Eigen::Vector3d& dir) const {
+  double u, v;
+  to_uv(dir, u, v);
+  const double sin_theta = std::sin(kPi * v);
+  if (!(sin_theta > 0.0)) return 0.0;
+  const std::size_t px = pixel_at(u, v);
+  const double sin_row = std::sin(kPi * (static_cast<double>(px / m_width) + 0.5) / m_height);
+  return m_values[px] * sin_row / m_integral / (2.0 * kPi * kPi * sin_theta);
+}
+
+}  // namespace prizma::render
