@@ -272,12 +272,13 @@ void PathTracer::trace(const Ray& ray, Rng& rng, PathScratch& s) const {
     trace_lanes<0>(ray, rng, s);
 }
 
-void PathTracer::add_escape(const Eigen::Vector3d& dir, double phase_pdf, const float* w, PathScratch& s) const {
+void PathTracer::add_escape(const Eigen::Vector3d& dir, double phase_pdf, const float* w, float* lights_out,
+                            PathScratch& s) const {
   const int n = s.lanes;
   for (int k : m_escape_lights) {
     const auto radiance = static_cast<float>(m_lights[k].escape_radiance(dir, phase_pdf));
     if (!(radiance > 0.0f)) continue;
-    float* __restrict out = s.directional.data() + static_cast<std::size_t>(k) * n;
+    float* __restrict out = lights_out + static_cast<std::size_t>(k) * n;
     for (int i = 0; i < n; ++i) out[i] += w[i] * radiance;
   }
 }
@@ -366,7 +367,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   double t_enter, t_exit;
   if (!intersect_box(camera_ray, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) {
     for (int i = 0; i < n; ++i) env[i] = 1.0f;
-    add_escape(dir, 0.0, w, s);
+    add_escape(dir, 0.0, w, dir_out, s);
     return;
   }
   double phase_pdf = 0.0;  // density of dir's last draw from the phase function (0: camera ray)
@@ -465,7 +466,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     if (!scattered) {
       // Escaped: the unit environment (and the environment maps) seen with the path's weight.
       for (int i = 0; i < n; ++i) env[i] += w[i];
-      add_escape(dir, phase_pdf, w, s);
+      add_escape(dir, phase_pdf, w, dir_out, s);
       return;
     }
     if (m_max_bounces >= 0 && bounces >= m_max_bounces) return;
@@ -559,7 +560,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     const Ray next{pos, dir};
     if (!intersect_box(next, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) {
       for (int i = 0; i < n; ++i) env[i] += w[i];
-      add_escape(dir, phase_pdf, w, s);
+      add_escape(dir, phase_pdf, w, dir_out, s);
       return;
     }
   }

@@ -212,6 +212,31 @@ TEST(RenderLights, ConstantEnvironmentMapIsTheUniformEnvironment) {
   for (float v : f.lights[0].data) ASSERT_NEAR(v, 1.0f, 1e-6f);
 }
 
+TEST(RenderLights, ConstantEnvironmentMapIsTheUniformEnvironmentAfterFluorescence) {
+  // The same in a fluorescent medium: light that escapes after a re-emission belongs to the
+  // bispectral terms of its layer. A map's escapes once went to the diagonal there (the light
+  // sampler and fluorescence were merged with the escape writing to the diagonal layers only).
+  Material dye = grey_material(0.5, 2.0);
+  dye.fluorescent = true;
+  dye.fluorescence.absorption = Spectrum({400.0, 500.0}, {2.0, 0.0});
+  dye.fluorescence.emission = Spectrum({550.0, 700.0}, {1.0, 1.0});
+  dye.fluorescence.quantum_yield = 0.8;
+  Scene s = box_scene(dye, 4, 8, 16);
+  s.camera.ortho_height = 1.6;
+  s.lights = {testing::environment_light("env"), map_light("sky", constant_map(1.0f))};
+  const auto img = render(s);
+  ASSERT_EQ(img.lights.size(), 2u);
+  ASSERT_FALSE(img.reradiation.empty());
+  ASSERT_EQ(img.lights[0].data, img.lights[1].data);
+  ASSERT_EQ(img.lights[0].reradiation.size(), img.lights[1].reradiation.size());
+  double total = 0.0;
+  for (std::size_t k = 0; k < img.lights[0].reradiation.size(); ++k) {
+    ASSERT_EQ(img.lights[0].reradiation[k], img.lights[1].reradiation[k]) << "bispectral value " << k;
+    total += img.lights[0].reradiation[k];
+  }
+  EXPECT_GT(total, 0.0);  // the dye re-emits under the environment
+}
+
 TEST(RenderLights, ConstantEnvironmentMapWithNeeKeepsTheFurnace) {
   // The MIS estimator forced on a constant map: NEE by the map's distribution and phase sampling,
   // power heuristic; an albedo-1 medium under unit radiance stays at 1 (3 standard errors), also

@@ -99,8 +99,11 @@ class PathTracer {
   void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s,
                      double t_max = std::numeric_limits<double>::infinity()) const;
   // A path leaving the medium along dir: the environment maps' radiance, MIS-weighted against NEE
-  // by the density phase_pdf its direction was drawn with (0 = a camera ray), times the weights.
-  void add_escape(const Eigen::Vector3d& dir, double phase_pdf, const float* w, PathScratch& s) const;
+  // by the density phase_pdf its direction was drawn with (0 = a camera ray), times the weights,
+  // added to lights_out (the light layers: s.directional, or after a fluorescent event the in side
+  // of the re-radiation term, s.fl_directional).
+  void add_escape(const Eigen::Vector3d& dir, double phase_pdf, const float* w, float* lights_out,
+                  PathScratch& s) const;
   void evaluate_material(int m, PathScratch& s) const;
   void evaluate_fluorescence(int m, PathScratch& s) const;
   void fluoresce(int m, float density, float k, Rng& rng, PathScratch& s) const;
