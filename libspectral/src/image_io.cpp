@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
@@ -67,6 +68,27 @@ const mod::Module* load_module() {
     for (const fs::path& p : paths) looked += (looked.empty() ? "" : ", ") + p.string();
     throw RuntimeError("cannot find the image module " + std::string(kModuleFile) +
                        " (needed for PNG, TIFF and transfer-function images; looked in: " + looked + ")");
+  }
+  // Near an address-space limit, OpenImageIO's dependencies fail inside their initialisers in
+  // ways that cannot all be caught (log4cplus calls std::terminate; one limit, 485 MB, hung): the
+  // ~450 MB its libraries map must be there before it is loaded.
+  if (address_space_limited()) {
+    rlimit lim{};
+    ::getrlimit(RLIMIT_AS, &lim);
+    long long used_kb = 0;
+    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
+      char line[256];
+      while (std::fgets(line, sizeof line, f) != nullptr)
+        if (std::sscanf(line, "VmSize: %lld kB", &used_kb) == 1) break;
+      std::fclose(f);
+    }
+    constexpr long long kNeededMb = 512;
+    const long long left_mb = static_cast<long long>(lim.rlim_cur / (1024 * 1024)) - used_kb / 1024;
+    if (left_mb < kNeededMb) {
+      throw RuntimeError("out of memory loading the image module " + chosen.string() + " (" +
+                         std::to_string(left_mb) + " MB of address space left under the limit; it maps about " +
+                         std::to_string(kNeededMb) + " MB)");
+    }
   }
   void* handle = nullptr;
   {

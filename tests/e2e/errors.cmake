@@ -151,7 +151,7 @@ endif()
 # module when it writes (400–500 MB: log4cplus, loaded with it, gives up starting its thread).
 # Not in sanitizer builds: ASan reserves terabytes of address space.
 if(NOT PRIZMA_SANITIZE AND NOT PRIZMA_FUZZ AND TARGET prizma-render AND TARGET prizma-relight)
-  set(_limits 400,420,440,450,460,480,490,500,510,550,600,800,1200,2000,4000)
+  set(_limits 400,420,440,450,460,480,500,550,600,800,1200,2000,4000)
   add_test(NAME errors.e2e.render_out_of_memory
            COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-memory-limits --workdir ${_errors_work}
                    --output mem_render.exr --limits-mb 16,20,24,28,32,40,50,64,100,${_limits} -- $<TARGET_FILE:prizma-render> good.json -q -o mem_render.exr)
