@@ -16,6 +16,8 @@ pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO)
 # prizma-relight -i: line editing and history (libedit-dev), inline images in sixel terminals (libsixel-dev).
 pkg_check_modules(LIBEDIT REQUIRED IMPORTED_TARGET libedit)
 pkg_check_modules(SIXEL REQUIRED IMPORTED_TARGET libsixel)
+# Highway (libhwy-dev): run-time SIMD dispatch of the relight kernel (relight/src/relight_simd.cpp).
+pkg_check_modules(HWY REQUIRED IMPORTED_TARGET libhwy)
 
 # libnifti's CMake config points at a non-multiarch path: find the pieces by hand.
 find_package(ZLIB REQUIRED)

@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include <system_error>
 
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/stderr_capture.h"
 
 #ifndef PRIZMA_VERSION
 #define PRIZMA_VERSION "0.0.0"
@@ -63,18 +65,36 @@ bool message_says_out_of_memory(std::string_view what) {
   return false;
 }
 
+namespace {
+// What LoadGuard is loading ("" when nothing): for the messages of a crash or an exception in a
+// library's initialiser. A fixed buffer: read by a signal handler.
+char g_load_what[256] = {};
+}  // namespace
+
 void report_uncaught_and_exit(const char* program) noexcept {
   // stdio only and no allocation: this may run before the C++ library's own initialisation
-  // (iostreams), and memory may be exhausted.
+  // (iostreams), and memory may be exhausted. A StderrCapture may hold stderr: the line goes to
+  // the real one.
+  if (detail::g_captured_stderr >= 0) ::dup2(detail::g_captured_stderr, STDERR_FILENO);
   const char* reason = "unknown failure";
   const char* detail = "";
   try {
     if (const std::exception_ptr e = std::current_exception()) std::rethrow_exception(e);
-    reason = "terminated (no exception)";
+    // A library that calls std::terminate itself (log4cplus's initialiser when it cannot start its
+    // thread, loaded with OpenImageIO) leaves no exception: under an address-space limit that is
+    // running out of memory.
+    rlimit lim{};
+    const bool limited = ::getrlimit(RLIMIT_AS, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY;
+    reason = !limited                 ? "terminated (no exception)"
+             : g_load_what[0] != '\0' ? "out of memory: a library stopped the program while "
+                                       : "out of memory: a library stopped the program while starting up";
+    if (limited && g_load_what[0] != '\0') detail = g_load_what;
   } catch (const std::bad_alloc&) {
     reason = "out of memory (while a library started up or shut down, outside Prizma's code)";
   } catch (const std::system_error& e) {
-    reason = is_out_of_resources(e) ? "out of memory: a library cannot start its threads before main: " : "";
+    reason = !is_out_of_resources(e) ? ""
+             : g_load_what[0] != '\0' ? "out of memory: a library cannot start its threads: "
+                                       : "out of memory: a library cannot start its threads before main: ";
     detail = e.what();
   } catch (const std::exception& e) {
     reason = "";
@@ -100,13 +120,26 @@ extern "C" void on_startup_crash(int) {
       ": error: out of memory: a library crashed while starting up, before main (its allocation failed under the "
       "address-space limit)\n";
   static const char kOther[] = ": error: a library crashed while starting up, before main (SIGSEGV)\n";
+  static const char kLoadMsg[] = ": error: out of memory: a library crashed while ";
+  static const char kLoadTail[] = " (its allocation failed under the address-space limit)\n";
+  static const char kLoadOther[] = ": error: a library crashed (SIGSEGV) while ";
   rlimit lim{};
   const bool limited = ::getrlimit(RLIMIT_AS, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY;
   const char* p = g_startup_program != nullptr ? g_startup_program : "prizma";
-  std::size_t n = 0;
-  while (p[n] != '\0') ++n;
-  [[maybe_unused]] ssize_t w = ::write(STDERR_FILENO, p, n);
-  w = limited ? ::write(STDERR_FILENO, kMsg, sizeof kMsg - 1) : ::write(STDERR_FILENO, kOther, sizeof kOther - 1);
+  if (detail::g_captured_stderr >= 0) ::dup2(detail::g_captured_stderr, STDERR_FILENO);
+  const auto put = [](const char* s) {
+    std::size_t n = 0;
+    while (s[n] != '\0') ++n;
+    [[maybe_unused]] const ssize_t w = ::write(STDERR_FILENO, s, n);
+  };
+  put(p);
+  if (g_load_what[0] != '\0') {
+    put(limited ? kLoadMsg : kLoadOther);
+    put(g_load_what);
+    put(limited ? kLoadTail : "\n");
+  } else {
+    put(limited ? kMsg : kOther);
+  }
   ::_exit(kExitRuntime);
 }
 }  // namespace
@@ -132,6 +165,19 @@ void end_startup_guard() noexcept {
   ::sigaction(SIGBUS, &g_old_bus, nullptr);
   if (g_altstack_set) ::sigaltstack(&g_old_altstack, nullptr);  // the sanitizers' own, if any
   g_guard_active = false;
+}
+
+LoadGuard::LoadGuard(const std::string& what) noexcept {
+  const std::size_t n = std::min(what.size(), sizeof g_load_what - 1);
+  std::memcpy(g_load_what, what.data(), n);
+  g_load_what[n] = '\0';
+  m_installed = !g_guard_active;
+  if (m_installed) begin_startup_guard(g_startup_program != nullptr ? g_startup_program : "prizma");
+}
+
+LoadGuard::~LoadGuard() {
+  if (m_installed) end_startup_guard();
+  g_load_what[0] = '\0';
 }
 
 int check_standard_output(const std::string& program, int rc) {

@@ -1,6 +1,5 @@
 #include "prizma/relight/output_image.h"
 
-#include <OpenImageIO/imageio.h>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -8,7 +7,7 @@
 
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/oiio_atomic_output.h"
+#include "prizma/spectral/image_io.h"
 
 namespace prizma::relight {
 
@@ -74,24 +73,25 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
     for (float& v : pixels)
       if (!std::isfinite(v)) v = 0.0f;
   }
-  OIIO::TypeDesc type = OIIO::TypeDesc::FLOAT;
+  spectral::PictureSpec spec;
+  spec.width = image.width;
+  spec.height = image.height;
+  spec.stored = spectral::PicturePixelType::Float;
   if (format != OutputFormat::Exr) {
     for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
-    type = opts.bit_depth == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
+    spec.stored = opts.bit_depth == 16 ? spectral::PicturePixelType::UInt16 : spectral::PicturePixelType::UInt8;
   }
-
-  OIIO::ImageSpec spec(image.width, image.height, 3, type);
   if (format == OutputFormat::Exr && opts.display.colour_space.empty()) {
-    spec.channelnames = {"X", "Y", "Z"};
+    spec.channel_names = {"X", "Y", "Z"};
   } else {
-    spec.channelnames = {"R", "G", "B"};
+    spec.channel_names = {"R", "G", "B"};
   }
-  if (format == OutputFormat::Exr) spec.attribute("compression", "zip");
-  if (format == OutputFormat::Jpeg) spec.attribute("Compression", "jpeg:95");
-  for (const auto& [key, value] : metadata) spec.attribute(key, value);
+  if (format == OutputFormat::Exr) spec.attributes.emplace_back("compression", "zip");
+  if (format == OutputFormat::Jpeg) spec.attributes.emplace_back("Compression", "jpeg:95");
+  for (const auto& [key, value] : metadata) spec.attributes.emplace_back(key, value);
 
   spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {
-    spectral::write_oiio_image(out, spec, OIIO::TypeDesc::FLOAT, pixels.data());
+    spectral::write_picture(out, spec, spectral::PicturePixelType::Float, pixels.data());
   });
 }
 

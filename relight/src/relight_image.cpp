@@ -8,55 +8,14 @@
 #include <vector>
 
 #include "prizma/spectral/bispectral.h"
+#include "prizma/relight/relight_simd.h"
 #include "prizma/spectral/error.h"
 
 namespace prizma::relight {
 
 namespace {
 
-// One light's matrix in row-major order (3 rows of n weights) and its layer's transport.
-struct LayerTerm {
-  const float* weights;    // 3·n floats, row-major
-  const float* transport;  // width·height·n floats, pixel-major, bins contiguous
-};
-
-// XYZ of a row of pixels: for each pixel Σ_l M_l·T_l. N > 0 fixes the bin count at compile time so
-// Eigen unrolls the three dot products into SIMD packets; N = 0 is the general case.
-template <int N>
-void relight_row(const std::vector<LayerTerm>& terms, int n, std::size_t first_pixel, int width, float* out) {
-  constexpr int kRows = 3;
-  using Weights = Eigen::Matrix<float, kRows, (N > 0 ? N : Eigen::Dynamic), Eigen::RowMajor>;
-  using Bins = Eigen::Matrix<float, (N > 0 ? N : Eigen::Dynamic), 1>;
-  const std::size_t stride = static_cast<std::size_t>(n);
-  for (int x = 0; x < width; ++x) {
-    const std::size_t p = first_pixel + static_cast<std::size_t>(x);
-    Eigen::Vector3f xyz = Eigen::Vector3f::Zero();
-    for (const LayerTerm& term : terms) {
-      const Eigen::Map<const Weights> m(term.weights, kRows, n);
-      const Eigen::Map<const Bins> t(term.transport + p * stride, n);
-      xyz.noalias() += m.lazyProduct(t);
-    }
-    out[3 * x + 0] = xyz.x();
-    out[3 * x + 1] = xyz.y();
-    out[3 * x + 2] = xyz.z();
-  }
-}
-
-using RowKernel = void (*)(const std::vector<LayerTerm>&, int, std::size_t, int, float*);
-
-RowKernel kernel_for(int n) {
-  switch (n) {
-    case 4: return &relight_row<4>;
-    case 8: return &relight_row<8>;
-    case 12: return &relight_row<12>;
-    case 16: return &relight_row<16>;
-    case 24: return &relight_row<24>;
-    case 32: return &relight_row<32>;
-    case 48: return &relight_row<48>;
-    case 64: return &relight_row<64>;
-    default: return &relight_row<0>;
-  }
-}
+using LayerTerm = detail::SimdLayer;  // weights: 3·n floats row-major; transport: pixel-major, bins contiguous
 
 }  // namespace
 
@@ -143,12 +102,12 @@ void relight_into(const spectral::SpectralImage& image, const RelightMatrix& mat
     }
     if (!m.isZero(0.0)) terms.push_back({w, data.data()});
   }
-  const RowKernel kernel = kernel_for(n);
   const int width = image.width;
   tbb::parallel_for(tbb::blocked_range<int>(0, image.height), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y != rows.end(); ++y) {
       const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
-      kernel(terms, n, first, width, xyz_out + 3 * first);
+      // Highway's run-time dispatch: the widest SIMD this CPU has (relight_simd.cpp).
+      detail::relight_row_simd(terms.data(), static_cast<int>(terms.size()), n, first, width, xyz_out + 3 * first);
     }
   });
   if (!image.reradiation.empty()) {

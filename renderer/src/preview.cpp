@@ -1,6 +1,4 @@
 // write_preview(): an 8-bit sRGB picture of a transport image under its lights' default spectra.
-#include <OpenImageIO/imageio.h>
-
 #include <cmath>
 
 #include "prizma/render/render.h"
@@ -9,7 +7,7 @@
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/light_spectrum.h"
-#include "prizma/spectral/oiio_atomic_output.h"
+#include "prizma/spectral/image_io.h"
 
 namespace prizma::render {
 
@@ -43,17 +41,21 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
       rgb8[p * 3 + c] = static_cast<unsigned char>(std::lround(e * 255.0));
     }
   }
-  const OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  spectral::PictureSpec spec;
+  spec.width = image.width;
+  spec.height = image.height;
+  spec.stored = spectral::PicturePixelType::UInt8;
   spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {
-    spectral::write_oiio_image(out, spec, OIIO::TypeDesc::UINT8, rgb8.data());
+    spectral::write_picture(out, spec, spectral::PicturePixelType::UInt8, rgb8.data());
   });
 }
 
 void check_preview_path(const std::filesystem::path& path, const std::string& input) {
   spectral::check_output_file(path, input);
-  if (!OIIO::ImageOutput::create(path.string())) {
-    throw spectral::InputError(input, "\"" + path.string() + "\": cannot write this image format (" +
-                                          OIIO::geterror() + "); use .png");
+  std::string reason;
+  if (!spectral::can_write_picture(path.string(), reason)) {
+    throw spectral::InputError(input, "\"" + path.string() + "\": cannot write this image format (" + reason +
+                                          "); use .png");
   }
 }
 

@@ -2,16 +2,17 @@
 // volume.
 #include "prizma/render/transfer_function.h"
 
-#include <OpenImageIO/imageio.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/image_io.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/stderr_capture.h"
 
@@ -42,19 +43,6 @@ constexpr double kMaxAbsG = 0.999;
 // claims a huge image is refused before anything is allocated.
 constexpr long long kMaxTfPixels = 1LL << 22;
 constexpr long long kMaxTfExpansion = 4096;
-
-// The last error OpenImageIO holds (global, then the reader's), on one line; clearing both, so
-// that nothing is left for OpenImageIO to print at exit.
-std::string oiio_error(OIIO::ImageInput* in) {
-  std::string e = in != nullptr ? in->geterror() : std::string();
-  const std::string global = OIIO::geterror();
-  if (e.empty()) e = global;
-  for (char& c : e) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  while (!e.empty() && e.back() == ' ') e.pop_back();
-  return e.empty() ? "unknown error" : e;
-}
 
 }  // namespace
 
@@ -134,16 +122,16 @@ TransferFunction read_transfer_function_image(const std::filesystem::path& image
   const auto file_bytes = static_cast<long long>(std::filesystem::file_size(image, ec));
   // libpng prints its errors on stderr before OpenImageIO reports them: captured into the one line.
   spectral::StderrCapture open_capture;
-  auto in = OIIO::ImageInput::open(file);
+  std::string open_error;
+  const std::unique_ptr<spectral::PictureReader> in = spectral::open_picture(file, open_error);
   const std::string open_printed = open_capture.finish();
   if (!in) {
-    const std::string e = oiio_error(nullptr);
+    const std::string& e = open_error;
     throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("libpng", open_printed, e));
   }
-  const OIIO::ImageSpec spec = in->spec();
-  const int w = spec.width;
-  const int h = spec.height;
-  const int nc = spec.nchannels;
+  const int w = in->width();
+  const int h = in->height();
+  const int nc = in->channels();
   if (w < 1 || h < 1) throw InputError(input, "image " + file + " is empty");
   if (nc < 3) throw InputError(input, "image " + file + " has " + std::to_string(nc) + " channel(s); needs R, G, B");
   const long long pixels = static_cast<long long>(w) * h;
@@ -151,7 +139,7 @@ TransferFunction read_transfer_function_image(const std::filesystem::path& image
     throw InputError(input, "image " + file + " is " + std::to_string(w) + "×" + std::to_string(h) +
                                 " pixels; a transfer function has at most " + std::to_string(kMaxTfPixels) + " pixels");
   }
-  const long long decoded = pixels * nc * static_cast<long long>(spec.format.size());
+  const long long decoded = pixels * nc * static_cast<long long>(in->channel_bytes());
   if (ec || decoded > kMaxTfExpansion * std::max(file_bytes, 1LL)) {
     throw InputError(input, "image " + file + " claims " + std::to_string(w) + "×" + std::to_string(h) + "×" +
                                 std::to_string(nc) + " pixels, more than its " + std::to_string(file_bytes) +
@@ -159,13 +147,13 @@ TransferFunction read_transfer_function_image(const std::filesystem::path& image
   }
   std::vector<float> px(static_cast<std::size_t>(pixels) * nc);
   spectral::StderrCapture read_capture;
-  const bool read_ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, px.data());
+  std::string read_error;
+  const bool read_ok = in->read_float(px.data(), read_error);
   const std::string read_printed = read_capture.finish();
   if (!read_ok) {
-    const std::string e = oiio_error(in.get());
+    const std::string& e = read_error;
     throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("libpng", read_printed, e));
   }
-  in->close();
 
   // Wavelengths of the pixel centres.
   std::vector<double> lambda(w);

@@ -10,6 +10,13 @@
 
 namespace prizma::spectral {
 
+namespace detail {
+// The real stderr while a StderrCapture is active (-1 otherwise): the fatal handlers of tool_main
+// (a library crashing or calling std::terminate while loading, e.g. the image module) put it back
+// so that their one line is seen, not lost in the capture's file.
+inline volatile int g_captured_stderr = -1;
+}  // namespace detail
+
 class StderrCapture {
  public:
   StderrCapture() {
@@ -17,7 +24,11 @@ class StderrCapture {
     m_file = std::tmpfile();
     if (m_file == nullptr) return;
     m_saved = ::dup(STDERR_FILENO);
-    if (m_saved < 0 || ::dup2(::fileno(m_file), STDERR_FILENO) < 0) restore();
+    if (m_saved < 0 || ::dup2(::fileno(m_file), STDERR_FILENO) < 0) {
+      restore();
+    } else if (detail::g_captured_stderr < 0) {
+      detail::g_captured_stderr = m_saved;
+    }
   }
   ~StderrCapture() { restore(); }
   StderrCapture(const StderrCapture&) = delete;
@@ -48,6 +59,7 @@ class StderrCapture {
  private:
   void restore() {
     if (m_saved >= 0) {
+      if (detail::g_captured_stderr == m_saved) detail::g_captured_stderr = -1;
       std::fflush(stderr);
       ::dup2(m_saved, STDERR_FILENO);
       ::close(m_saved);

@@ -71,6 +71,21 @@ decltype(auto) allocating(std::string_view what, F&& f) {
 void begin_startup_guard(const char* program) noexcept;
 void end_startup_guard() noexcept;
 
+// The same guard around a library loaded after main (dlopen of the image module, whose
+// OpenImageIO initialisers are those above): while it lives, a SIGSEGV/SIGBUS or an exception
+// escaping an initialiser becomes one line "<program>: error: [out of memory: ]… while <what>",
+// exit 1. Not thread-safe: one at a time (the loader holds its lock).
+class LoadGuard {
+ public:
+  explicit LoadGuard(const std::string& what) noexcept;
+  ~LoadGuard();
+  LoadGuard(const LoadGuard&) = delete;
+  LoadGuard& operator=(const LoadGuard&) = delete;
+
+ private:
+  bool m_installed = false;
+};
+
 }  // namespace prizma::spectral
 
 // In an executable's main.cpp: installs the terminate handler from the executable's

@@ -1,0 +1,104 @@
+#pragma once
+// Pictures (PNG, TIFF, EXR images that are not spectral files) and transfer-function images,
+// through OpenImageIO — which is not linked into the tools. Debian's OpenImageIO pulls in about 260
+// shared libraries (OpenVDB, log4cplus, ffmpeg, …) that cost a tool ~0.25 s and ~100 MB before main;
+// a spectral render or relight that reads and writes only spectral EXRs (OpenEXR, linked) needs
+// none of them. The OpenImageIO code lives in the module libprizma_imageio.so, loaded (dlopen) the
+// first time one of the functions below is called. It is looked for, in order:
+//   $PRIZMA_IMAGE_IO_MODULE (a path: for tests and unusual installs)
+//   <folder of the executable>/libprizma_imageio.so
+//   <folder of the executable>/../lib/prizma/libprizma_imageio.so   (installed layout)
+//   the build tree's module (the path it was built at)
+// A module that cannot be loaded is a RuntimeError ("cannot load the image module <path>: <why>";
+// "out of memory loading the image module …" when the address space ran out), exit 1.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace prizma::spectral {
+
+class AtomicOutput;
+
+enum class PicturePixelType { UInt8, UInt16, Float };
+
+struct PictureSpec {
+  int width = 0;
+  int height = 0;
+  int channels = 3;
+  PicturePixelType stored = PicturePixelType::UInt8;           // type in the file
+  std::vector<std::string> channel_names;                       // empty: OpenImageIO's default (R, G, B, …)
+  std::vector<std::pair<std::string, std::string>> attributes;  // string metadata, e.g. {"compression", "zip"}
+};
+
+// Writes one picture into `out` (write_atomically's checked temporary), the format chosen by
+// out.destination()'s extension. `pixels` are `given` values, channels interleaved, rows top to
+// bottom. Every byte goes through `out`, so a short write fails the file whatever the writer says.
+// Throws RuntimeError "<destination>: <reason>" (the write's own failure takes precedence).
+void write_picture(AtomicOutput& out, const PictureSpec& spec, PicturePixelType given, const void* pixels);
+
+// True when OpenImageIO can write the format of `path` (by its extension); otherwise false with
+// OpenImageIO's reason in `reason`.
+bool can_write_picture(const std::string& path, std::string& reason);
+
+// A picture opened for reading.
+class PictureReader {
+ public:
+  virtual ~PictureReader() = default;
+  virtual int width() const = 0;
+  virtual int height() const = 0;
+  virtual int channels() const = 0;
+  virtual std::size_t channel_bytes() const = 0;  // bytes per channel value in the file
+  // Reads the whole first subimage as floats (8-bit values become value/255), channels
+  // interleaved, into width·height·channels floats. False with the reader's error, on one line.
+  virtual bool read_float(float* pixels, std::string& error) = 0;
+};
+
+// Opens `path`; nullptr with OpenImageIO's error (one line) when it cannot be read.
+std::unique_ptr<PictureReader> open_picture(const std::string& path, std::string& error);
+
+// Whether the module has been loaded in this process (diagnostics and tests).
+bool image_io_module_loaded();
+
+namespace image_io_module {
+
+// What the module exports: extern "C" const Module* prizma_image_io_module_v1(). Compiled with
+// the same compiler and library as the tools (it is built with them), so C++ types cross.
+constexpr int kAbiVersion = 1;
+constexpr const char* kEntryPoint = "prizma_image_io_module_v1";
+
+// The bytes of the file being written (an AtomicOutput, adapted by the tool's side). Never throws.
+class ByteSink {
+ public:
+  virtual std::int64_t tell() = 0;
+  virtual bool seek(std::int64_t offset) = 0;
+  virtual bool write(const void* data, std::size_t n) = 0;
+  virtual bool write_at(const void* data, std::size_t n, std::int64_t offset) = 0;
+  virtual std::size_t read_at(void* data, std::size_t n, std::int64_t offset) = 0;
+  virtual std::int64_t size() = 0;
+
+ protected:
+  ~ByteSink() = default;
+};
+
+enum class WriteStatus { Ok, UnknownFormat, NoIoProxy, Failed };
+
+class Module {
+ public:
+  virtual int abi_version() const = 0;
+  virtual bool can_write(const std::string& filename, std::string& reason) const = 0;
+  // Failed: `reason` is the writer's message, or `what` failed when it gave none; UnknownFormat:
+  // OpenImageIO's message.
+  virtual WriteStatus write(ByteSink& sink, const std::string& filename, const PictureSpec& spec,
+                            PicturePixelType given, const void* pixels, std::string& reason) const = 0;
+  virtual std::unique_ptr<PictureReader> open(const std::string& filename, std::string& error) const = 0;
+
+ protected:
+  ~Module() = default;
+};
+
+}  // namespace image_io_module
+
+}  // namespace prizma::spectral

@@ -1,0 +1,27 @@
+#pragma once
+// The relight row kernel with run-time SIMD dispatch (relight_simd.cpp, Highway).
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace prizma::relight::detail {
+
+// One light layer: its 3×n weights row-major (X row, Y row, Z row) and its transport
+// (width·height·n floats, pixel-major, bins contiguous).
+struct SimdLayer {
+  const float* weights;
+  const float* transport;
+};
+
+// out[3x + c] = Σ_l Σ_i weights_l[c·n + i] · transport_l[(first_pixel + x)·n + i], x in [0, width).
+void relight_row_simd(const SimdLayer* layers, int layer_count, int n, std::size_t first_pixel, int width,
+                      float* out);
+
+// The targets compiled in that this CPU runs, best first (e.g. "AVX3", "AVX2", "SSE4", …, "EMU128").
+std::vector<std::string> relight_simd_targets();
+// The one relight_row_simd uses now.
+std::string relight_simd_target();
+// Tests: use only the named target from now on ("" = back to the best). Not thread-safe.
+void relight_simd_force_target(const std::string& name);
+
+}  // namespace prizma::relight::detail
