@@ -30,6 +30,18 @@ if(NOT TARGET prizma_nifti)
   target_link_libraries(prizma_nifti INTERFACE ${NIFTI_IO_LIBRARY} ${NIFTI_ZNZ_LIBRARY} ZLIB::ZLIB m)
 endif()
 
+# OpenVDB 10 (libopenvdb-dev): Debian installs only Find modules under a path find_package does not
+# search, and they look for Blosc, IlmBase and more that the shared library already links: find the
+# library and header by hand; its headers need Imath's half (from OpenEXR's Imath) and TBB.
+find_path(OPENVDB_INCLUDE_DIR openvdb/openvdb.h REQUIRED)
+find_library(OPENVDB_LIBRARY openvdb REQUIRED)
+find_package(Imath CONFIG REQUIRED)
+if(NOT TARGET prizma_openvdb)
+  add_library(prizma_openvdb INTERFACE)
+  target_include_directories(prizma_openvdb SYSTEM INTERFACE ${OPENVDB_INCLUDE_DIR})
+  target_link_libraries(prizma_openvdb INTERFACE ${OPENVDB_LIBRARY} Imath::Imath TBB::tbb)
+endif()
+
 if(PRIZMA_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

@@ -4,7 +4,13 @@
 #include <cmath>
 #include <limits>
 
+#include "prizma/render/volume.h"
+
 namespace prizma::render {
+
+namespace {
+float majorant_over_values(const Medium& medium, const std::vector<float>& sigma_t_max, float v_lo, float v_hi);
+}  // namespace
 
 MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma_t_max, int cell_voxels)
     : m_min(medium.bounds_min), m_max_corner(medium.bounds_max) {
@@ -19,7 +25,11 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
     m_cell_size[a] = voxel * span[a];
   }
   m_majorant.assign(static_cast<std::size_t>(m_cells[0]) * m_cells[1] * m_cells[2], 0.0f);
-  if (medium.interpolation == Interpolation::Trilinear) {
+  bool blocks_fit = !medium.block_range.empty();
+  for (int a = 0; a < 3; ++a) blocks_fit = blocks_fit && (span[a] % Volume::kBlockVoxels == 0 || m_cells[a] == 1);
+  if (blocks_fit) {
+    build_from_blocks(medium, sigma_t_max, span);
+  } else if (medium.interpolation == Interpolation::Trilinear) {
     build_trilinear(medium, sigma_t_max, span);
   } else {
     for (int z = 0; z < d[2]; ++z)
@@ -34,7 +44,79 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
           cell = std::max(cell, mu);
         }
   }
+  if (!medium.clip.empty()) zero_clipped_cells(medium);
   for (float mu : m_majorant) m_max = std::max(m_max, mu);
+}
+
+namespace {
+
+// The largest σt that any value in [v_lo, v_hi] classifies to: for every rule whose range meets it,
+// its ramp's largest density there × the material's largest σt (plus one float ulp: the tracer
+// evaluates the ramp at the point in double and rounds).
+float majorant_over_values(const Medium& medium, const std::vector<float>& sigma_t_max, float v_lo, float v_hi) {
+  if (!(v_lo <= v_hi)) return 0.0f;
+  float mu = 0.0f;
+  for (const MaterialRule& r : medium.rules) {
+    const double a = std::max<double>(r.value_lo, v_lo), b = std::min<double>(r.value_hi, v_hi);
+    if (!(a <= b)) continue;
+    const auto dmax = static_cast<float>(r.density.max_over(a, b));
+    mu = std::max(mu, dmax * sigma_t_max[static_cast<std::size_t>(r.material)]);
+  }
+  if (mu > 0.0f) mu = std::nextafter(mu, std::numeric_limits<float>::infinity());
+  return mu;
+}
+
+}  // namespace
+
+void MajorantGrid::build_from_blocks(const Medium& medium, const std::vector<float>& sigma_t_max,
+                                     const std::array<int, 3>& span) {
+  // A sparse volume (OpenVDB) gives each block of kBlockVoxels³ voxels the range of values its points
+  // interpolate between, neighbours included, from the tree's nodes; a cell is a union of whole blocks.
+  // The bound over a value range holds for nearest lookups too (a voxel's value lies in its block's
+  // range), so both interpolations use it.
+  constexpr int kB = Volume::kBlockVoxels;
+  std::array<int, 3> nb{};
+  for (int a = 0; a < 3; ++a) nb[a] = (medium.dims[a] + kB - 1) / kB;
+  for (int cz = 0; cz < m_cells[2]; ++cz)
+    for (int cy = 0; cy < m_cells[1]; ++cy)
+      for (int cx = 0; cx < m_cells[0]; ++cx) {
+        const int c[3] = {cx, cy, cz};
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = m_cells[a] == 1 ? 0 : c[a] * span[a] / kB;
+          hi[a] = m_cells[a] == 1 ? nb[a] - 1 : std::min(nb[a] - 1, (c[a] + 1) * span[a] / kB - 1);
+        }
+        float v_lo = std::numeric_limits<float>::infinity(), v_hi = -v_lo;
+        for (int z = lo[2]; z <= hi[2]; ++z)
+          for (int y = lo[1]; y <= hi[1]; ++y)
+            for (int x = lo[0]; x <= hi[0]; ++x) {
+              const auto& r = medium.block_range[(static_cast<std::size_t>(z) * nb[1] + y) * nb[0] + x];
+              v_lo = std::min(v_lo, r[0]);
+              v_hi = std::max(v_hi, r[1]);
+            }
+        m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] =
+            majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
+      }
+}
+
+void MajorantGrid::zero_clipped_cells(const Medium& medium) {
+  // A cell whose every corner lies on the removed side of one clip plane holds no medium (the side
+  // is a half-space, so the whole box does): its majorant 0 stays a bound and costs one DDA step.
+  for (int cz = 0; cz < m_cells[2]; ++cz)
+    for (int cy = 0; cy < m_cells[1]; ++cy)
+      for (int cx = 0; cx < m_cells[0]; ++cx) {
+        const Eigen::Vector3d lo = m_min + Eigen::Vector3d(cx, cy, cz).cwiseProduct(m_cell_size);
+        const Eigen::Vector3d hi = lo + m_cell_size;
+        for (const ClipPlane& p : medium.clip) {
+          // The box's corner with the least dot(normal, ·).
+          double least = 0.0;
+          for (int a = 0; a < 3; ++a) least += p.normal[a] * (p.normal[a] >= 0.0 ? lo[a] : hi[a]);
+          if (least > p.offset) {
+            m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] = 0.0f;
+            break;
+          }
+        }
+      }
 }
 
 void MajorantGrid::build_trilinear(const Medium& medium, const std::vector<float>& sigma_t_max,
@@ -65,16 +147,7 @@ void MajorantGrid::build_trilinear(const Medium& medium, const std::vector<float
               v_hi = std::max(v_hi, row[x]);
             }
           }
-        if (!(v_lo <= v_hi)) continue;
-        float mu = 0.0f;
-        for (const MaterialRule& r : medium.rules) {
-          const double a = std::max<double>(r.value_lo, v_lo), b = std::min<double>(r.value_hi, v_hi);
-          if (!(a <= b)) continue;
-          const auto dmax = static_cast<float>(r.density.max_over(a, b));
-          mu = std::max(mu, dmax * sigma_t_max[static_cast<std::size_t>(r.material)]);
-        }
-        // One float ulp of headroom: the tracer evaluates the ramp at the point in double, rounds.
-        if (mu > 0.0f) mu = std::nextafter(mu, std::numeric_limits<float>::infinity());
+        const float mu = majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
         m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] = mu;
       }
 }

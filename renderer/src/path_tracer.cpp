@@ -200,6 +200,11 @@ void PathTracer::evaluate_fluorescence(int m, PathScratch& s) const {
 
 void PathTracer::lookup(const Eigen::Vector3d& p, std::uint16_t& material, float& density) const {
   const Medium& med = *m_medium;
+  if (!med.clip.empty() && med.clipped(p)) {  // cut away: empty, so a null collision (unbiased)
+    material = Medium::kEmpty;
+    density = 0.0f;
+    return;
+  }
   if (m_trilinear) {
     classify(interpolate(p), material, density);
     return;

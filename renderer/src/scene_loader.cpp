@@ -192,7 +192,7 @@ class Fnv1a {
 Volume read_volume(const Reader& rd, const json& j) {
   const std::string path = "volume";
   if (!j.is_object()) rd.fail(path, "must be an object (got " + Reader::describe(j) + ")");
-  if (!j.contains("type")) rd.fail(Reader::join(path, "type"), "is required (raw, nifti or procedural)");
+  if (!j.contains("type")) rd.fail(Reader::join(path, "type"), "is required (raw, nifti, vdb or procedural)");
   const std::string type = rd.string(j.at("type"), Reader::join(path, "type"));
   Volume vol;
   bool spacing_given = j.contains("spacing");
@@ -205,7 +205,7 @@ Volume read_volume(const Reader& rd, const json& j) {
     }
   }
   if (type == "procedural") {
-    rd.expect_object(j, path, {"type", "name", "resolution", "spacing", "interpolation"});
+    rd.expect_object(j, path, {"type", "name", "resolution", "spacing", "interpolation", "clip"});
     if (!j.contains("name")) rd.fail(Reader::join(path, "name"), "is required");
     const std::string name = rd.string(j.at("name"), Reader::join(path, "name"));
     const auto names = procedural_volume_names();
@@ -219,7 +219,7 @@ Volume read_volume(const Reader& rd, const json& j) {
                         : kDefaultResolution;
     vol = make_procedural_volume(name, res);
   } else if (type == "raw") {
-    rd.expect_object(j, path, {"type", "path", "dims", "voxel_type", "endianness", "spacing", "interpolation"});
+    rd.expect_object(j, path, {"type", "path", "dims", "voxel_type", "endianness", "spacing", "interpolation", "clip"});
     if (!j.contains("path")) rd.fail(Reader::join(path, "path"), "is required");
     RawVolumeSpec spec;
     spec.path = rd.file_path(j.at("path"), Reader::join(path, "path"));
@@ -248,14 +248,46 @@ Volume read_volume(const Reader& rd, const json& j) {
     spec.spacing = spacing;
     vol = load_raw_volume(spec);
   } else if (type == "nifti") {
-    rd.expect_object(j, path, {"type", "path", "spacing", "interpolation"});
+    rd.expect_object(j, path, {"type", "path", "spacing", "interpolation", "clip"});
     if (!j.contains("path")) rd.fail(Reader::join(path, "path"), "is required");
     vol = load_nifti_volume(rd.file_path(j.at("path"), Reader::join(path, "path")));
+  } else if (type == "vdb") {
+    rd.expect_object(j, path, {"type", "path", "grid", "spacing", "interpolation", "clip"});
+    if (!j.contains("path")) rd.fail(Reader::join(path, "path"), "is required");
+    const std::string grid = j.contains("grid") ? rd.string(j.at("grid"), Reader::join(path, "grid")) : "density";
+    if (grid.empty()) rd.fail(Reader::join(path, "grid"), "must not be empty");
+    vol = load_vdb_volume(rd.file_path(j.at("path"), Reader::join(path, "path")), grid);
   } else {
-    rd.fail(Reader::join(path, "type"), "must be \"raw\", \"nifti\" or \"procedural\" (got \"" + type + "\")");
+    rd.fail(Reader::join(path, "type"), "must be \"raw\", \"nifti\", \"vdb\" or \"procedural\" (got \"" + type + "\")");
   }
   if (spacing_given) vol.spacing = spacing;
   return vol;
+}
+
+// volume.clip: up to 64 planes {"normal": [x, y, z], "offset": d}; the medium is removed where
+// dot(normal, p) > d, exactly as written (the normal need not be unit length; it is normalised with d).
+std::vector<ClipPlane> read_clip(const Reader& rd, const json& j) {
+  std::vector<ClipPlane> planes;
+  if (!j.is_object() || !j.contains("clip")) return planes;
+  const std::string path = "volume.clip";
+  const json& c = j.at("clip");
+  if (!c.is_array()) rd.fail(path, "must be an array of planes {\"normal\": [x, y, z], \"offset\": d} (got " + Reader::describe(c) + ")");
+  if (c.size() > 64) rd.fail(path, "at most 64 clip planes (got " + std::to_string(c.size()) + ")");
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const std::string pp = Reader::index(path, i);
+    rd.expect_object(c[i], pp, {"normal", "offset"});
+    if (!c[i].contains("normal")) rd.fail(Reader::join(pp, "normal"), "is required");
+    const auto n = rd.vec3(c[i].at("normal"), Reader::join(pp, "normal"));
+    const double offset = c[i].contains("offset") ? rd.number(c[i].at("offset"), Reader::join(pp, "offset")) : 0.0;
+    ClipPlane plane;
+    plane.normal = Eigen::Vector3d(n[0], n[1], n[2]);
+    const double len = plane.normal.norm();
+    if (!(len > 0.0) || !std::isfinite(len)) rd.fail(Reader::join(pp, "normal"), "must not be the zero vector");
+    plane.normal /= len;
+    plane.offset = offset / len;
+    planes.push_back(plane);
+  }
+  return planes;
 }
 
 // volume.interpolation: "trilinear" (default) or "nearest".
@@ -918,11 +950,14 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverr
   if (root.contains("output")) scene.output = rd.file_path(root.at("output"), "output");
 
   const Interpolation interpolation = read_interpolation(rd, root.at("volume"));
+  std::vector<ClipPlane> clip = read_clip(rd, root.at("volume"));
   Volume vol = read_volume(rd, root.at("volume"));
   const ValueNormalisation norm = read_normalisation(rd, root, vol);
   const TransferFunction tf = has_materials ? read_materials(rd, root.at("materials"), norm)
                                             : read_tf_image(rd, root.at("transfer_function"), norm);
   scene.medium = build_medium(vol, tf, rd.input("volume"), interpolation);
+  scene.medium.clip = std::move(clip);
+  scene.volume_note = vol.orientation;
   check_trackable(rd, scene.medium, has_materials);
 
   // Emission: one light layer for every emitting material, only when some material emits (a scene

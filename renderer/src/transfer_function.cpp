@@ -246,6 +246,10 @@ Medium build_medium(const Volume& vol, const TransferFunction& tf, const std::st
     m.value = vol.values;
     m.rules = tf.rules;
   }
+  if (!vol.block_range.empty()) {  // a sparse source's block ranges: the majorant grid classifies them
+    m.block_range = vol.block_range;
+    m.rules = tf.rules;
+  }
 
   // World box: dims × spacing, largest side 1, centred at the origin.
   double extent[3];

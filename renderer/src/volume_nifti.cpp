@@ -73,6 +73,70 @@ void check_raw_header(const std::string& input) {
   }
 }
 
+// Reorders the voxels (axis permutation and flips, no resampling) so that +x, +y, +z point to the
+// patient's Right, Anterior and Superior by the sform (preferred when sform_code > 0) or the qform;
+// libnifti's nifti_mat44_to_orientation names the closest anatomical direction of each file axis.
+// Returns the note for the render's log.
+std::string orient_ras(const nifti_image& nim, Volume& vol) {
+  const char* source = nullptr;
+  mat44 m{};
+  if (nim.sform_code > 0) {
+    source = "sform";
+    m = nim.sto_xyz;
+  } else if (nim.qform_code > 0) {
+    source = "qform";
+    m = nim.qto_xyz;
+  } else {
+    return "NIfTI orientation: none (sform_code and qform_code are 0): file axes kept as +x, +y, +z";
+  }
+  int code[3] = {0, 0, 0};
+  nifti_mat44_to_orientation(m, &code[0], &code[1], &code[2]);
+  // Code c (NIFTI_L2R = 1 … NIFTI_S2I = 6): world axis (c − 1) / 2 (R, A, S), positive when c is odd.
+  static const char* const kDir[6] = {"R", "L", "A", "P", "S", "I"};
+  int out_of[3] = {-1, -1, -1};  // world axis → file axis
+  bool flip[3] = {false, false, false};
+  std::string file_axes;
+  bool oblique = false;
+  for (int i = 0; i < 3; ++i) {
+    if (code[i] < 1 || code[i] > 6) return std::string("NIfTI orientation: the ") + source + " is degenerate: file axes kept";
+    const int w = (code[i] - 1) / 2;
+    if (out_of[w] >= 0) return std::string("NIfTI orientation: the ") + source + " is degenerate: file axes kept";
+    out_of[w] = i;
+    flip[w] = code[i] % 2 == 0;
+    file_axes += std::string(i == 0 ? "" : " ") + "+" + "ijk"[i] + "→" + kDir[code[i] - 1];
+    double len = 0.0;
+    for (int r = 0; r < 3; ++r) len += static_cast<double>(m.m[r][i]) * m.m[r][i];
+    if (std::abs(m.m[w][i]) < 0.9999 * std::sqrt(len)) oblique = true;
+  }
+  const std::array<int, 3> src = vol.dims;
+  std::array<int, 3> dims{};
+  std::array<double, 3> spacing{};
+  for (int w = 0; w < 3; ++w) {
+    dims[w] = src[out_of[w]];
+    spacing[w] = vol.spacing[out_of[w]];
+  }
+  const bool identity = out_of[0] == 0 && out_of[1] == 1 && out_of[2] == 2 && !flip[0] && !flip[1] && !flip[2];
+  if (!identity) {
+    std::vector<float> out(vol.values.size());
+    const std::size_t stride[3] = {1, static_cast<std::size_t>(src[0]), static_cast<std::size_t>(src[0]) * src[1]};
+    std::size_t k = 0;
+    for (int z = 0; z < dims[2]; ++z)
+      for (int y = 0; y < dims[1]; ++y)
+        for (int x = 0; x < dims[0]; ++x) {
+          const int c[3] = {x, y, z};
+          std::size_t from = 0;
+          for (int w = 0; w < 3; ++w) from += stride[out_of[w]] * static_cast<std::size_t>(flip[w] ? dims[w] - 1 - c[w] : c[w]);
+          out[k++] = vol.values[from];
+        }
+    vol.values = std::move(out);
+    vol.dims = dims;
+    vol.spacing = spacing;
+  }
+  return std::string("NIfTI orientation (") + source + "): file " + file_axes +
+         (identity ? ", kept as" : ", reordered to") + " +x→R +y→A +z→S (world x = patient right, y = anterior, z = superior)" +
+         (oblique ? "; oblique axes snapped to the nearest, not resampled" : "");
+}
+
 std::string datatype_name(int dt) {
   const char* s = nifti_datatype_to_string(dt);
   return s != nullptr ? std::string(s) : "datatype " + std::to_string(dt);
@@ -204,6 +268,7 @@ Volume load_nifti_volume(const std::filesystem::path& path) {
     case DT_FLOAT64: convert<double>(data, count, slope, inter, vol.values); break;
     default: break;
   }
+  vol.orientation = orient_ras(*nim, vol);
   return vol;
 }
 

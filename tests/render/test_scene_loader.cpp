@@ -400,8 +400,8 @@ TEST(SceneLoaderErrors, CameraAndSettings) {
 TEST(SceneLoaderErrors, VolumeAndTransferFunction) {
   ScratchDir dir;
   json j = base_scene();
-  j["volume"]["type"] = "vdb";
-  expect_error(dir, j, "volume.type", "\"raw\", \"nifti\" or \"procedural\"");
+  j["volume"]["type"] = "dicom";
+  expect_error(dir, j, "volume.type", "\"raw\", \"nifti\", \"vdb\" or \"procedural\"");
   j = base_scene();
   j["volume"]["name"] = "teapot";
   expect_error(dir, j, "volume.name", "unknown procedural volume");

@@ -34,6 +34,8 @@ class MajorantGrid {
 
  private:
   void build_trilinear(const Medium& medium, const std::vector<float>& sigma_t_max, const std::array<int, 3>& span);
+  void build_from_blocks(const Medium& medium, const std::vector<float>& sigma_t_max, const std::array<int, 3>& span);
+  void zero_clipped_cells(const Medium& medium);
 
   std::array<int, 3> m_cells{1, 1, 1};
   Eigen::Vector3d m_min{0, 0, 0}, m_max_corner{0, 0, 0}, m_cell_size{1, 1, 1};

@@ -44,6 +44,13 @@ struct Material {
 // raw value interpolated trilinearly between voxel centres and then classified.
 enum class Interpolation { Nearest, Trilinear };
 
+// A cut-away plane: the medium is removed where dot(normal, p) > offset (p in world units, the
+// box's frame); normal is unit length. Points with dot(normal, p) ≤ offset keep their medium.
+struct ClipPlane {
+  Eigen::Vector3d normal{0, 0, 1};
+  double offset = 0.0;
+};
+
 // The medium the tracer sees: a box in world space split into voxels, each holding a material
 // index (or kEmpty) and a density multiplier (the classification at the voxel centre). With
 // Nearest a voxel is a homogeneous cell; with Trilinear the tracer interpolates `value` (raw values
@@ -59,6 +66,16 @@ struct Medium {
   Interpolation interpolation = Interpolation::Nearest;
   std::vector<float> value;          // Trilinear: raw value per voxel, x fastest (non-finite = empty)
   std::vector<MaterialRule> rules;   // Trilinear: value → material and density, first match wins
+  // Volume::block_range carried over (Volume::kBlockVoxels³ blocks); empty = read the voxels.
+  std::vector<std::array<float, 2>> block_range;
+  std::vector<ClipPlane> clip;       // cut-aways: medium removed on the positive side of any plane
+
+  // True when p lies on the removed side of some clip plane.
+  bool clipped(const Eigen::Vector3d& p) const {
+    for (const ClipPlane& c : clip)
+      if (c.normal.dot(p) > c.offset) return true;
+    return false;
+  }
 
   std::size_t voxel_count() const { return static_cast<std::size_t>(dims[0]) * dims[1] * dims[2]; }
 };
@@ -132,6 +149,7 @@ struct Scene {
   std::filesystem::path output;  // default output (scene's "output"), resolved against the scene folder
   std::string hash;              // hash of the scene file text and the volume bytes
   std::filesystem::path source;  // the scene file
+  std::string volume_note;       // for the render's log: the volume's orientation, if any (Volume::orientation)
 };
 
 // A command-line override of one scene field (prizma-render -D KEY=VALUE).
