@@ -55,6 +55,7 @@ struct CliOptions {
   std::string bind = "127.0.0.1";
   int port = 0;
   std::string save_dir = ".";
+  bool no_verify = false;
 };
 
 const char* cmf_table(spectral::Observer obs) {
@@ -130,8 +131,11 @@ int run(const CliOptions& o) {
   if (!o.output.empty()) relight::check_output_path(o.output, "--output");
   if (!o.preview.empty()) relight::check_output_path(o.preview, "--preview");
 
-  relight::RelightSession session =
-      spectral::allocating("reading " + o.input, [&] { return relight::RelightSession(o.input); });
+  spectral::ExrReadOptions read_options;
+  read_options.verify_checksum = !o.no_verify;
+  relight::RelightSession session = spectral::allocating("reading " + o.input, [&] {
+    return relight::RelightSession(spectral::read_spectral_exr(o.input, read_options), o.input);
+  });
   const relight::RelightSettings cli_settings = settings_from(o, session);
   session.apply(cli_settings);
   if (!o.output.empty()) {
@@ -232,6 +236,8 @@ int main(int argc, char** argv) {
   app.add_option("--preview", o.preview, "interactive: image rewritten after every change");
   app.add_flag("--show", o.show, "print a true-colour terminal thumbnail (with -i: draw the image at the start)");
   app.add_flag("--show-every", o.show_every, "interactive: draw the image after every change");
+  app.add_flag("--no-verify", o.no_verify,
+               "read the input even when its pixels do not match prizma:checksum (a file re-encoded by another tool)");
   app.add_flag("--verbose", o.verbose, "echo data files, OCIO config and lights");
   app.add_flag("--serve", o.serve, "serve the live relighting page (prints its URL; Ctrl-C stops it)");
   app.add_option("--bind", o.bind, "--serve: address to listen on")->capture_default_str();
