@@ -124,8 +124,10 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
     if (const auto chromaticities = exr_chromaticities(opts)) {
       spec.attribute("chromaticities", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8), chromaticities->data());
     }
-  } else {
-    spec.attribute("oiio:ColorSpace", opts.display.display);  // the display it is encoded for
+  } else if (format == OutputFormat::Png) {
+    // The display it is encoded for (OpenImageIO writes the sRGB chunk for "sRGB"). Not for TIFF:
+    // OpenImageIO 2.4's TIFF writer then leaves a file without its ImageLength field.
+    spec.attribute("oiio:ColorSpace", opts.display.display);
   }
   for (const auto& [key, value] : metadata) spec.attribute(key, value);
 
