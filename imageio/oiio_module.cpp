@@ -98,6 +98,9 @@ class OiioModule final : public mod::Module {
     OIIO::ImageSpec spec(ps.width, ps.height, ps.channels, type_of(ps.stored));
     if (!ps.channel_names.empty()) spec.channelnames = ps.channel_names;
     for (const auto& [key, value] : ps.attributes) spec.attribute(key, value);
+    for (const auto& [key, values] : ps.float_attributes) {
+      spec.attribute(key, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, static_cast<int>(values.size())), values.data());
+    }
     SinkProxy proxy(filename, sink);
     std::unique_ptr<OIIO::ImageOutput> image = OIIO::ImageOutput::create(filename, &proxy);
     if (!image) {

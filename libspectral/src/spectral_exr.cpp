@@ -45,8 +45,11 @@
 #include <vector>
 
 #include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/colour.h"
+#include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
+#include "prizma/spectral/light_spectrum.h"
 #include "prizma/spectral/tool_main.h"
 #include "bispectral_exr.h"
 #include "text_util.h"
@@ -71,7 +74,10 @@ constexpr const char* kAttrWavelengthSampling = "prizma:wavelengthSampling";
 constexpr const char* kAttrChecksum = "prizma:checksum";
 constexpr const char* kAttrScenePath = "prizma:scenePath";
 constexpr const char* kAttrRenderOptions = "prizma:renderOptions";
-constexpr const char* kChecksumScheme = "fnv1a64-words:";
+// Checksum versions (the value's prefix): v2 also covers the top-level T layer of a file with two or
+// more lights (the sum of the lights); v1, written before it, covers the light and variance layers.
+constexpr const char* kChecksumScheme = "fnv1a64-words-v2:";
+constexpr const char* kChecksumSchemeV1 = "fnv1a64-words:";
 constexpr const char* kVarianceLayer = "var";
 constexpr float kHalfMax = 65504.0f;
 constexpr double kSpeedOfLight_m_per_s = 299792458.0;
@@ -193,6 +199,7 @@ struct OutLayer {
 constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
 constexpr std::uint64_t kFnvBasisLight = 0xcbf29ce484222325ULL;
 constexpr std::uint64_t kFnvBasisVariance = 0x84222325cbf29ce4ULL;
+constexpr std::uint64_t kFnvBasisSum = 0xe4842223cbf2925cULL;  // the top-level T layer (v2)
 
 template <typename Value>
 std::uint64_t layer_hash(const Value* v, std::size_t n, std::uint64_t basis) {
@@ -223,19 +230,96 @@ class AtomicOStream final : public Imf::OStream {
   AtomicOutput& m_out;
 };
 
-std::string checksum_string(std::uint64_t sum) {
+std::string checksum_string(std::uint64_t sum, const char* scheme = kChecksumScheme) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(sum));
-  return std::string(kChecksumScheme) + buf;
+  return std::string(scheme) + buf;
+}
+
+// v1: the light and variance layers, summed over layers modulo 2⁶⁴.
+std::uint64_t light_layers_hash(const SpectralImage& image) {
+  std::uint64_t sum = 0;
+  for (const auto& light : image.lights) {
+    sum += layer_hash(light.data.data(), light.data.size(), kFnvBasisLight);
+    if (!light.variance.empty()) sum += layer_hash(light.variance.data(), light.variance.size(), kFnvBasisVariance);
+  }
+  return sum;
+}
+
+// The top-level T layer of a file with two or more lights: per value the float of the double sum over
+// the lights (what the writer stores).
+std::vector<float> sum_of_lights(const SpectralImage& image) {
+  const std::size_t n = image.lights.empty() ? 0 : image.lights.front().data.size();
+  std::vector<float> sum(n, 0.0f);
+  for (std::size_t k = 0; k < n; ++k) {
+    double s = 0.0;
+    for (const auto& light : image.lights) s += light.data[k];
+    sum[k] = static_cast<float>(s);
+  }
+  return sum;
+}
+
+// The preview channels R, G, B, for viewers that do not read spectra (JCGT 2021 recommends them): the
+// default relight, as prizma-relight makes it without options (each light at the spectrum recorded
+// in prizma:lights, else D65; CIE 1931 2°; a perfect white at Y = 1; exposure 0), in linear sRGB
+// (IEC 61966-2-1 primaries, D65 white). A light whose recorded spectrum cannot be used here (a csv:
+// left on another machine) is left out, as prizma-relight leaves it off; empty when every light is,
+// or the CIE tables cannot be read.
+std::vector<float> preview_rgb(const SpectralImage& image) {
+  const nlohmann::json recorded = image.info.lights_json.empty()
+                                      ? nlohmann::json::array()
+                                      : nlohmann::json::parse(image.info.lights_json, nullptr, false);
+  const ColorMatching* cmf = nullptr;
+  try {
+    cmf = &ColorMatching::get(Observer::Cie1931_2deg);
+  } catch (const std::exception&) {
+    return {};
+  }
+  const Eigen::Matrix3d to_rgb = xyz_to_linear_srgb_matrix();
+  const int n = image.bins.size();
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> weights;  // per light, RGB ← bins
+  bool any = false;
+  for (const auto& layer : image.lights) {
+    std::string spec = "D65";  // RelightSession's rule: the entry named after the layer, or the only one
+    if (recorded.is_array()) {
+      for (const auto& entry : recorded) {
+        if (!entry.is_object() || !entry.contains("spectrum") || !entry["spectrum"].is_string()) continue;
+        const std::string name = entry.value("name", std::string());
+        if (name == layer.name || (image.lights.size() == 1 && recorded.size() == 1)) spec = entry["spectrum"].get<std::string>();
+      }
+    }
+    Eigen::Matrix<double, 3, Eigen::Dynamic> w = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, n);
+    try {
+      const LightSpectrum light = parse_light_spectrum(spec);
+      if (!light.off) {
+        w = to_rgb * relight_weights(*cmf, light, image.bins);
+        any = true;
+      }
+    } catch (const std::exception&) {
+      // left out (off)
+    }
+    weights.push_back(std::move(w));
+  }
+  if (!any) return {};
+  std::vector<float> rgb(image.pixel_count() * 3);
+  for (std::size_t px = 0; px < image.pixel_count(); ++px) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (std::size_t l = 0; l < image.lights.size(); ++l) {
+      const float* t = image.lights[l].data.data() + px * static_cast<std::size_t>(n);
+      for (int i = 0; i < n; ++i) sum += weights[l].col(i) * static_cast<double>(t[i]);
+    }
+    for (int c = 0; c < 3; ++c) rgb[3 * px + static_cast<std::size_t>(c)] = std::isfinite(sum[c]) ? static_cast<float>(sum[c]) : 0.0f;
+  }
+  return rgb;
 }
 
 }  // namespace
 
 std::string spectral_pixel_checksum(const SpectralImage& image) {
-  std::uint64_t sum = 0;
-  for (const auto& light : image.lights) {
-    sum += layer_hash(light.data.data(), light.data.size(), kFnvBasisLight);
-    if (!light.variance.empty()) sum += layer_hash(light.variance.data(), light.variance.size(), kFnvBasisVariance);
+  std::uint64_t sum = light_layers_hash(image);
+  if (image.lights.size() >= 2) {
+    const std::vector<float> total = sum_of_lights(image);
+    sum += layer_hash(total.data(), total.size(), kFnvBasisSum);
   }
   sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
   return checksum_string(sum);
@@ -310,12 +394,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   std::vector<float> sum;
   std::vector<OutLayer> layers;
   if (multi) {
-    sum.assign(expected, 0.0f);
-    for (std::size_t k = 0; k < expected; ++k) {
-      double s = 0.0;
-      for (const auto& light : image.lights) s += light.data[k];
-      sum[k] = static_cast<float>(s);
-    }
+    sum = sum_of_lights(image);
     check_finite(sum, image.width, bins, "sum of all lights", p);
     layers.push_back({"", &sum, "sum of all lights", LayerKind::Sum});
     for (const auto& light : image.lights) {
@@ -368,14 +447,23 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
     }
   }
 
+  // Preview channels R, G, B (derived from the layers, so outside the checksum); half files clamp them
+  // to half's range.
+  const std::vector<float> preview = opts.write_preview ? preview_rgb(image) : std::vector<float>();
+  std::vector<half> preview_half;
+  if (half_out) {
+    for (const float v : preview) preview_half.emplace_back(std::clamp(v, -kHalfMax, kHalfMax));
+  }
+
   // Checksum of what a reader will get back (half files: the values after conversion to half).
   std::uint64_t checksum = 0;
   {
     auto half_it = half_buffers.begin();
     for (const auto& layer : layers) {
       const half* hv = half_out ? (half_it++)->data() : nullptr;
-      if (layer.kind == LayerKind::Sum) continue;
-      const std::uint64_t basis = layer.kind == LayerKind::Light ? kFnvBasisLight : kFnvBasisVariance;
+      const std::uint64_t basis = layer.kind == LayerKind::Light   ? kFnvBasisLight
+                                  : layer.kind == LayerKind::Sum ? kFnvBasisSum
+                                                                 : kFnvBasisVariance;
       checksum += half_out ? layer_hash(hv, expected, basis) : layer_hash(layer.data->data(), expected, basis);
     }
   }
@@ -388,6 +476,9 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   const Imf::PixelType type = half_out ? Imf::HALF : Imf::FLOAT;
   for (const auto& layer : layers) {
     for (int i = 0; i < bins; ++i) header.channels().insert(layer.prefix + suffixes[i], Imf::Channel(type));
+  }
+  if (!preview.empty()) {
+    for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(type));
   }
   header.insert("spectralLayoutVersion", Imf::StringAttribute(kLayoutVersion));
   {
@@ -437,6 +528,15 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   detail::ReradiationBuffers rerad_buffers;
   if (const std::uint64_t rc = detail::add_reradiation_for_write(image, multi, half_out, header, fb, rerad_buffers, p); rc != 0)
     header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum + rc)));
+  if (!preview.empty()) {
+    const char* base = half_out ? reinterpret_cast<const char*>(preview_half.data())
+                                : reinterpret_cast<const char*>(preview.data());
+    const std::size_t stride = 3 * elem;
+    for (std::size_t c = 0; c < 3; ++c) {
+      fb.insert(c == 0 ? "R" : c == 1 ? "G" : "B",
+                Imf::Slice(type, const_cast<char*>(base + elem * c), stride, stride * static_cast<std::size_t>(image.width)));
+    }
+  }
 
   write_atomically(path, [&](AtomicOutput& out) {
     try {
@@ -641,9 +741,67 @@ void add_slices(Imf::FrameBuffer& fb, const LayerChannels& layer, std::vector<fl
   }
 }
 
+// What the header says about a file whose pixels do not match prizma:checksum: the signs that
+// another tool re-encoded it (such tools copy prizma: attributes but not the exact values), or "".
+std::string reencoding_signs(const Imf::Header& h) {
+  std::vector<std::string> signs;
+  const Imf::Compression c = h.compression();
+  if (c != Imf::PIZ_COMPRESSION) {
+    static const std::map<Imf::Compression, std::pair<const char*, bool>> kNames = {
+        {Imf::NO_COMPRESSION, {"none", false}},  {Imf::RLE_COMPRESSION, {"RLE", false}},
+        {Imf::ZIPS_COMPRESSION, {"ZIPS", false}}, {Imf::ZIP_COMPRESSION, {"ZIP", false}},
+        {Imf::PXR24_COMPRESSION, {"PXR24", true}}, {Imf::B44_COMPRESSION, {"B44", true}},
+        {Imf::B44A_COMPRESSION, {"B44A", true}},  {Imf::DWAA_COMPRESSION, {"DWAA", true}},
+        {Imf::DWAB_COMPRESSION, {"DWAB", true}}};
+    const auto it = kNames.find(c);
+    const std::string name = it == kNames.end() ? "unknown" : it->second.first;
+    const bool lossy = it != kNames.end() && it->second.second;
+    signs.push_back(std::string("its compression is ") + (lossy ? "the lossy " : "") + name + ", Prizma writes PIZ");
+  }
+  bool any_half = false, any_float = false;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+    (it.channel().type == Imf::HALF ? any_half : any_float) = true;
+  }
+  if (any_half && any_float) signs.push_back("it mixes half and float channels");
+  if (const auto* sw = h.findTypedAttribute<Imf::StringAttribute>("Software")) {
+    const std::string who = sw->value().substr(0, sw->value().find(" : "));
+    signs.push_back("it was written by " + detail::printable(who.substr(0, 80)));
+  }
+  std::string out;
+  for (const auto& s : signs) out += (out.empty() ? "" : "; ") + s;
+  return out;
+}
+
+// prizma:checksum against the pixels read: v2 with the top-level layer `top` (null when the file has
+// none, or one light), v1 without it.
+void verify_checksum(const std::string& p, const Imf::Header& header, const std::string& stored,
+                     const SpectralImage& image, const std::vector<float>* top) {
+  std::string expected;
+  if (stored.rfind(kChecksumScheme, 0) == 0) {
+    std::uint64_t sum = light_layers_hash(image);
+    if (top != nullptr) sum += layer_hash(top->data(), top->size(), kFnvBasisSum);
+    sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
+    expected = checksum_string(sum);
+  } else if (stored.rfind(kChecksumSchemeV1, 0) == 0) {
+    expected = checksum_string(light_layers_hash(image), kChecksumSchemeV1);
+  } else {
+    throw InputError(p, std::string(kAttrChecksum) + " \"" + stored + "\" is not of a known kind (expected " +
+                            kChecksumScheme + "<16 hex digits>, or " + kChecksumSchemeV1 + "<16 hex digits> in older files)");
+  }
+  if (stored == expected) return;
+  const std::string signs = reencoding_signs(header);
+  if (signs.empty()) {
+    throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) +
+                            " (the file is damaged; prizma-relight --no-verify reads it anyway)");
+  }
+  throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) +
+                          ": the file was probably re-encoded by another tool (" + signs +
+                          "), which kept the attribute but not the exact values; prizma-relight --no-verify reads it");
+}
+
 }  // namespace
 
-SpectralImage read_spectral_exr(const fs::path& path) {
+SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts) {
   const std::string p = path_string(path);
   require_regular_file(path, "an OpenEXR file");
   if (!Imf::isOpenExrFile(p.c_str())) throw InputError(p, "not an OpenEXR file");
@@ -853,20 +1011,21 @@ SpectralImage read_spectral_exr(const fs::path& path) {
       for (const auto& s : sources) light_prefixes.push_back(s.layer);
       detail::add_reradiation_for_read(rerad_channels, light_prefixes, lambdas, image, fb, dw, p);
     }
+    // The top-level T layer of a file with named light layers, read only to verify it (checksum v2).
+    const std::string* stored = opts.verify_checksum ? find_string_attr(header, kAttrChecksum) : nullptr;
+    std::vector<float> top;
+    const bool read_top = stored != nullptr && stored->rfind(kChecksumScheme, 0) == 0 && !light_layers.empty() &&
+                          layers.count("") != 0;
+    if (read_top) {
+      top.assign(count, 0.0f);
+      add_slices(fb, layers.at(""), top, dw, n);
+    }
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
 
     // A file written with a checksum must give back exactly what was written: PIZ has no check of
     // its own, so a damaged but complete file could otherwise read as other, finite values.
-    if (const auto* stored = find_string_attr(header, kAttrChecksum)) {
-      if (stored->rfind(kChecksumScheme, 0) != 0) {
-        throw InputError(p, std::string(kAttrChecksum) + " \"" + *stored + "\" is not of a known kind (expected " +
-                                kChecksumScheme + "<16 hex digits>)");
-      }
-      if (*stored != spectral_pixel_checksum(image)) {
-        throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) + " (the file is damaged)");
-      }
-    }
+    if (stored != nullptr) verify_checksum(p, header, *stored, image, read_top ? &top : nullptr);
     for (std::size_t k = 0; k < sources.size(); ++k) {
       const std::string what = sources[k].layer.empty() ? "layer T" : "layer \"" + sources[k].layer + "\"";
       check_finite(image.lights[k].data, image.width, n, what, p);

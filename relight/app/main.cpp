@@ -62,6 +62,7 @@ struct CliOptions {
   std::string bind = "127.0.0.1";
   int port = 0;
   std::string save_dir = ".";
+  bool no_verify = false;
 };
 
 const char* cmf_table(spectral::Observer obs) {
@@ -156,8 +157,11 @@ int run(const CliOptions& o) {
   check_options_used(o);
   if (!o.ocio.empty()) spectral::require_regular_file(o.ocio, "an OCIO config");
 
-  relight::RelightSession session =
-      spectral::allocating("reading " + o.input, [&] { return relight::RelightSession(o.input); });
+  spectral::ExrReadOptions read_options;
+  read_options.verify_checksum = !o.no_verify;
+  relight::RelightSession session = spectral::allocating("reading " + o.input, [&] {
+    return relight::RelightSession(spectral::read_spectral_exr(o.input, read_options), o.input);
+  });
   const relight::RelightSettings cli_settings = settings_from(o, session);
   session.apply(cli_settings);
   if (!o.output.empty()) {
@@ -265,6 +269,8 @@ int main(int argc, char** argv) {
   app.add_flag("-v,--verbose", o.verbose, "echo data files, OCIO config and lights");
   app.add_flag("-q,--quiet", o.quiet, "print nothing but errors (no warnings)");
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  app.add_flag("--no-verify", o.no_verify,
+               "read the input even when its pixels do not match prizma:checksum (a file re-encoded by another tool)");
   app.add_flag("--serve", o.serve, "serve the live relighting page (prints its URL; Ctrl-C stops it)");
   app.add_option("--bind", o.bind, "--serve: address to listen on")->capture_default_str();
   app.add_option("--port", o.port, "--serve: port (0: a free one)")->check(CLI::Range(0, 65535))->capture_default_str();

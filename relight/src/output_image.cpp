@@ -1,9 +1,13 @@
 #include "prizma/relight/output_image.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
@@ -57,6 +61,40 @@ std::vector<float> to_display(const XyzImage& image, const spectral::DisplayTran
   return rgb;
 }
 
+namespace {
+
+// The EXR "chromaticities" (red, green, blue, white xy) of an EXR output: XYZ's own for XYZ; for a
+// linear colour space those that take its RGB back to the image's XYZ (the OCIO transform's matrix M,
+// found from the XYZ unit vectors: the columns of M⁻¹ are the primaries' XYZ, M⁻¹·(1, 1, 1) the
+// white's). Nothing for a colour space that is not linear.
+std::optional<std::array<float, 8>> exr_chromaticities(const OutputOptions& opts) {
+  if (opts.display.colour_space.empty()) return std::array<float, 8>{1, 0, 0, 1, 0, 0, 1.0f / 3, 1.0f / 3};
+  const spectral::DisplayTransform transform(transform_options(OutputFormat::Exr, opts));
+  std::array<float, 9> unit{1, 0, 0, 0, 1, 0, 0, 0, 1}, half{0.5f, 0, 0, 0, 0.5f, 0, 0, 0, 0.5f};
+  transform.apply(unit.data(), 3);
+  transform.apply(half.data(), 3);
+  Eigen::Matrix3d m;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) {
+      m(r, c) = unit[static_cast<std::size_t>(3 * c + r)];
+      const double h = half[static_cast<std::size_t>(3 * c + r)];
+      if (!(std::abs(2.0 * h - m(r, c)) <= 1e-5 * (1.0 + std::abs(m(r, c))))) return std::nullopt;  // not linear
+    }
+  if (!(std::abs(m.determinant()) > 1e-12)) return std::nullopt;
+  const Eigen::Matrix3d inv = m.inverse();
+  std::array<float, 8> out{};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d xyz = k < 3 ? Eigen::Vector3d(inv.col(k)) : Eigen::Vector3d(inv * Eigen::Vector3d::Ones());
+    const double sum = xyz.sum();
+    if (!(std::abs(sum) > 1e-12)) return std::nullopt;
+    out[static_cast<std::size_t>(2 * k)] = static_cast<float>(xyz[0] / sum);
+    out[static_cast<std::size_t>(2 * k + 1)] = static_cast<float>(xyz[1] / sum);
+  }
+  return out;
+}
+
+}  // namespace
+
 void write_output_image(const fs::path& path, const XyzImage& image, const OutputOptions& opts,
                         const ImageMetadata& metadata) {
   const OutputFormat format = output_format_for(path);
@@ -86,8 +124,18 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
   } else {
     spec.channel_names = {"R", "G", "B"};
   }
-  if (format == OutputFormat::Exr) spec.attributes.emplace_back("compression", "zip");
-  if (format == OutputFormat::Jpeg) spec.attributes.emplace_back("Compression", "jpeg:95");
+  if (format == OutputFormat::Exr) {
+    spec.attributes.emplace_back("compression", "zip");
+    if (const auto chromaticities = exr_chromaticities(opts)) {
+      spec.float_attributes.emplace_back("chromaticities", std::vector<float>(chromaticities->begin(), chromaticities->end()));
+    }
+  } else if (format == OutputFormat::Png) {
+    // The display it is encoded for (OpenImageIO writes the sRGB chunk for "sRGB"). Not for TIFF:
+    // OpenImageIO 2.4's TIFF writer then leaves a file without its ImageLength field.
+    spec.attributes.emplace_back("oiio:ColorSpace", opts.display.display);
+  } else if (format == OutputFormat::Jpeg) {
+    spec.attributes.emplace_back("Compression", "jpeg:95");
+  }
   for (const auto& [key, value] : metadata) spec.attributes.emplace_back(key, value);
 
   spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +29,7 @@
 #include <iostream>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -178,9 +180,10 @@ TEST_F(SpectralExr, OneLightRoundTripIsBitExact) {
   const fs::path p = file("one.exr");
   write_spectral_exr(p, img);
 
-  // The file: top-level T channels only, no per-light layer, the layout version attribute.
+  // The file: top-level T channels only (and the R, G, B preview), no per-light layer, the layout
+  // version attribute.
   const auto names = channel_names(p);
-  EXPECT_EQ(names.size(), 12u);
+  EXPECT_EQ(names.size(), 12u + 3u);
   EXPECT_TRUE(has_channel(p, "T.412,500000nm"));
   EXPECT_FALSE(has_channel(p, "sun.T.412,500000nm"));
   {
@@ -221,8 +224,8 @@ TEST_F(SpectralExr, ThreeLightsWithVarianceRoundTrip) {
   const fs::path p = file("three.exr");
   write_spectral_exr(p, img);
 
-  // Top level (sum) + 3 light layers + 2 variance layers, 16 channels each.
-  EXPECT_EQ(channel_names(p).size(), 6u * 16u);
+  // Top level (sum) + 3 light layers + 2 variance layers, 16 channels each, and R, G, B.
+  EXPECT_EQ(channel_names(p).size(), 6u * 16u + 3u);
   EXPECT_TRUE(has_channel(p, "key.T.392,500000nm"));
   EXPECT_TRUE(has_channel(p, "key.var.T.392,500000nm"));
   EXPECT_FALSE(has_channel(p, "fill.var.T.392,500000nm"));
@@ -261,7 +264,7 @@ TEST_F(SpectralExr, VarianceCanBeLeftOut) {
   ExrWriteOptions opts;
   opts.write_variance = false;
   write_spectral_exr(p, img, opts);
-  EXPECT_EQ(channel_names(p).size(), 4u);
+  EXPECT_EQ(channel_names(p).size(), 4u + 3u);  // and the preview R, G, B
   EXPECT_TRUE(read_spectral_exr(p).lights[0].variance.empty());
   write_spectral_exr(p, img);
   EXPECT_TRUE(has_channel(p, "var.T.437,500000nm"));
@@ -492,8 +495,8 @@ TEST_F(SpectralExr, WritesChecksumOfWhatAReaderGets) {
     Imf::InputFile in(p.c_str());
     const auto* attr = in.header().findTypedAttribute<Imf::StringAttribute>("prizma:checksum");
     ASSERT_NE(attr, nullptr);
-    EXPECT_EQ(attr->value().rfind("fnv1a64-words:", 0), 0u) << attr->value();
-    EXPECT_EQ(attr->value().size(), std::string("fnv1a64-words:").size() + 16);
+    EXPECT_EQ(attr->value().rfind("fnv1a64-words-v2:", 0), 0u) << attr->value();
+    EXPECT_EQ(attr->value().size(), std::string("fnv1a64-words-v2:").size() + 16);
     EXPECT_NO_THROW(read_spectral_exr(p));  // half: the checksum is of the values after conversion
   }
 }
@@ -547,6 +550,134 @@ TEST_F(SpectralExr, RefusesUnknownChecksumKind) {
   });
   const std::string err = read_error(out);
   EXPECT_NE(err.find("not of a known kind"), std::string::npos) << err;
+}
+
+// Checksum v2 covers the top-level T layer (the sum of the lights); v1 files (older writers) still
+// read; a file re-encoded by another tool is refused naming the signs; verify_checksum off reads it.
+std::uint64_t checksum_value(const std::string& checksum) {
+  return std::stoull(checksum.substr(checksum.rfind(':') + 1), nullptr, 16);
+}
+
+// Copies an EXR, letting `edit` change any channel's values (read and written as float).
+fs::path rewrite_pixels(const fs::path& in_path, const fs::path& out,
+                        const std::function<void(const std::string& channel, std::vector<float>& values)>& edit) {
+  Imf::InputFile in(in_path.c_str());
+  const Imf::Header h = in.header();
+  const Imath::Box2i dw = h.dataWindow();
+  const std::size_t pixels = static_cast<std::size_t>(dw.max.x - dw.min.x + 1) * (dw.max.y - dw.min.y + 1);
+  std::map<std::string, std::vector<float>> values;
+  Imf::FrameBuffer fb;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+    auto& v = values[it.name()];
+    v.resize(pixels);
+    fb.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, v.data(), dw, sizeof(float),
+                                          sizeof(float) * static_cast<std::size_t>(dw.max.x - dw.min.x + 1)));
+  }
+  in.setFrameBuffer(fb);
+  in.readPixels(dw.min.y, dw.max.y);
+  for (auto& [name, v] : values) edit(name, v);
+  Imf::OutputFile o(out.c_str(), h);
+  o.setFrameBuffer(fb);
+  o.writePixels(dw.max.y - dw.min.y + 1);
+  return out;
+}
+
+TEST_F(SpectralExr, ChecksumCoversTheTopLevelSumLayer) {
+  const SpectralImage img = make_image(4, 3, BinLayout::linear(400, 700, 3), {"key", "fill"});
+  const fs::path p = file("two.exr");
+  write_spectral_exr(p, img);
+  // The checksum of the lights alone (v1) differs from the stored one: the sum is covered.
+  SpectralImage key = img, fill = img;
+  key.lights.erase(key.lights.begin() + 1);
+  fill.lights.erase(fill.lights.begin());
+  const std::uint64_t v1 = checksum_value(spectral_pixel_checksum(key)) + checksum_value(spectral_pixel_checksum(fill));
+  Imf::InputFile in(p.c_str());
+  const std::string stored = in.header().findTypedAttribute<Imf::StringAttribute>("prizma:checksum")->value();
+  EXPECT_EQ(stored, spectral_pixel_checksum(img));
+  EXPECT_NE(checksum_value(stored), v1);
+  // One value of the sum layer changed: refused.
+  const fs::path bad = rewrite_pixels(p, file("two-bad-sum.exr"), [](const std::string& name, std::vector<float>& v) {
+    if (name == "T.450,000000nm") v[5] += 0.25f;
+  });
+  const std::string err = read_error(bad);
+  EXPECT_NE(err.find("pixel data do not match prizma:checksum (the file is damaged"), std::string::npos) << err;
+  // The same file with a v1 checksum (an older writer's: lights only) is read: old files stay readable.
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(v1));
+  const fs::path old = rewrite_header(p, file("two-v1.exr"), [&](Imf::Header& h) {
+    h.insert("prizma:checksum", Imf::StringAttribute(std::string("fnv1a64-words:") + hex));
+  });
+  const SpectralImage back = read_spectral_exr(old);
+  EXPECT_EQ(back.lights[0].data, img.lights[0].data);
+  EXPECT_EQ(back.lights[1].data, img.lights[1].data);
+  // … and a wrong v1 value is still refused.
+  const fs::path old_bad = rewrite_header(p, file("two-v1-bad.exr"), [&](Imf::Header& h) {
+    h.insert("prizma:checksum", Imf::StringAttribute("fnv1a64-words:0123456789abcdef"));
+  });
+  EXPECT_NE(read_error(old_bad).find("do not match prizma:checksum"), std::string::npos);
+}
+
+TEST_F(SpectralExr, ReencodedFileIsNamedAsSuchAndReadsWithoutVerification) {
+  const SpectralImage img = make_image(16, 16, BinLayout::linear(400, 700, 4), {"key", "fill"});
+  const fs::path p = file("orig.exr");
+  write_spectral_exr(p, img);
+  // What oiiotool --compression pxr24 does: a lossy compression (floats rounded to 24 bits), its name.
+  const fs::path half_pxr24 = rewrite_header(p, file("pxr24.exr"), [](Imf::Header& h) {
+    h.compression() = Imf::PXR24_COMPRESSION;
+    h.insert("Software", Imf::StringAttribute("OpenImageIO 2.4.7.1 : oiiotool orig.exr --compression pxr24 -o pxr24.exr"));
+  });
+  const std::string err = read_error(half_pxr24);
+  EXPECT_NE(err.find("pixel data do not match prizma:checksum: the file was probably re-encoded by another tool "
+                     "(its compression is the lossy PXR24, Prizma writes PIZ; it was written by OpenImageIO 2.4.7.1)"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("--no-verify"), std::string::npos) << err;
+  ExrReadOptions no_verify;
+  no_verify.verify_checksum = false;
+  const SpectralImage back = read_spectral_exr(half_pxr24, no_verify);
+  ASSERT_EQ(back.lights.size(), 2u);
+  for (std::size_t k = 0; k < back.lights[0].data.size(); ++k) {
+    ASSERT_NEAR(back.lights[0].data[k], img.lights[0].data[k], 1e-4f * img.lights[0].data[k] + 1e-6f);
+  }
+  // ZIP, lossless but not Prizma's: named as well.
+  const fs::path zip = rewrite_pixels(
+      rewrite_header(p, file("zip.exr"), [](Imf::Header& h) { h.compression() = Imf::ZIP_COMPRESSION; }),
+      file("zip-edited.exr"), [](const std::string& name, std::vector<float>& v) {
+        if (name == "key.T.437,500000nm") v[0] *= 0.5f;
+      });
+  EXPECT_NE(read_error(zip).find("(its compression is ZIP, Prizma writes PIZ)"), std::string::npos) << read_error(zip);
+}
+
+TEST_F(SpectralExr, WritesTheDefaultRelightAsLinearSrgbPreview) {
+  // Light "a" at D65 on a perfect white (T = 1): linear sRGB (1, 1, 1) (D65 is sRGB's white, Y = 1);
+  // light "b" recorded as off adds nothing however bright its transport.
+  SpectralImage img = make_image(3, 2, BinLayout::linear(380, 780, 40), {"a", "b"});
+  std::fill(img.lights[0].data.begin(), img.lights[0].data.end(), 1.0f);
+  std::fill(img.lights[1].data.begin(), img.lights[1].data.end(), 5.0f);
+  img.info.lights_json = R"([{"name":"a","spectrum":"D65"},{"name":"b","spectrum":"off"}])";
+  const fs::path p = file("preview.exr");
+  write_spectral_exr(p, img);
+  {
+    Imf::InputFile in(p.c_str());
+    ASSERT_NE(in.header().channels().findChannel("R"), nullptr);
+    std::vector<float> rgb(3 * 6);
+    Imf::FrameBuffer fb;
+    const Imath::Box2i dw = in.header().dataWindow();
+    for (std::size_t c = 0; c < 3; ++c)
+      fb.insert(c == 0 ? "R" : c == 1 ? "G" : "B",
+                Imf::Slice::Make(Imf::FLOAT, rgb.data() + c, dw, 3 * sizeof(float), 9 * sizeof(float)));
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+    for (const float v : rgb) EXPECT_NEAR(v, 1.0f, 2e-3f);
+  }
+  const SpectralImage back = read_spectral_exr(p);  // the preview is no light and outside the checksum
+  ASSERT_EQ(back.lights.size(), 2u);
+  EXPECT_EQ(back.lights[0].data, img.lights[0].data);
+  ExrWriteOptions no_preview;
+  no_preview.write_preview = false;
+  write_spectral_exr(file("bare.exr"), img, no_preview);
+  Imf::InputFile bare(file("bare.exr").c_str());
+  EXPECT_EQ(bare.header().channels().findChannel("R"), nullptr);
 }
 
 TEST_F(SpectralExr, RefusesEmissiveOnly) {

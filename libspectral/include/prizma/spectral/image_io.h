@@ -31,6 +31,7 @@ struct PictureSpec {
   PicturePixelType stored = PicturePixelType::UInt8;           // type in the file
   std::vector<std::string> channel_names;                       // empty: OpenImageIO's default (R, G, B, …)
   std::vector<std::pair<std::string, std::string>> attributes;  // string metadata, e.g. {"compression", "zip"}
+  std::vector<std::pair<std::string, std::vector<float>>> float_attributes;  // e.g. {"chromaticities", 8 floats}
 };
 
 // Writes one picture into `out` (write_atomically's checked temporary), the format chosen by
@@ -66,7 +67,7 @@ namespace image_io_module {
 
 // What the module exports: extern "C" const Module* prizma_image_io_module_v1(). Compiled with
 // the same compiler and library as the tools (it is built with them), so C++ types cross.
-constexpr int kAbiVersion = 1;
+constexpr int kAbiVersion = 2;  // 2: PictureSpec::float_attributes
 constexpr const char* kEntryPoint = "prizma_image_io_module_v1";
 
 // The bytes of the file being written (an AtomicOutput, adapted by the tool's side). Never throws.

@@ -68,6 +68,9 @@ struct ExrWriteOptions {
   // With Half: clamp values above 65504 and warn on stderr, instead of refusing.
   bool clamp_half = false;
   bool write_variance = true;  // write var layers where present
+  // Preview channels R, G, B: the default relight (each light's recorded spectrum, CIE 1931) in linear
+  // sRGB, for viewers that do not read spectra. Not covered by the checksum; readers ignore them.
+  bool write_preview = true;
 };
 
 // Writes atomically (temporary file in the same folder, then rename): a failure never leaves a partial
@@ -80,11 +83,19 @@ void write_spectral_exr(const std::filesystem::path& path, const SpectralImage& 
 // at midpoints between centres, first and last bins mirrored). Throws InputError naming the path
 // for files that are not EXR, truncated, emissive-only, without spectral channels, or with
 // inconsistent edges and centres.
-SpectralImage read_spectral_exr(const std::filesystem::path& path);
+//
+// prizma:checksum is verified unless opts.verify_checksum is false: a mismatch is InputError "pixel
+// data do not match prizma:checksum", saying when the header shows that another tool re-encoded the
+// file (half, PXR24, B44: the values changed, the attribute was copied).
+struct ExrReadOptions {
+  bool verify_checksum = true;
+};
+SpectralImage read_spectral_exr(const std::filesystem::path& path, const ExrReadOptions& opts = {});
 
 // The prizma:checksum value of an image as held in memory (what read_spectral_exr returns): every
-// light's transport and variance values (docs/spectral-exr.md gives the definition). A file's stored
-// checksum equals this for the image read from it.
+// light's transport and variance values and, with two or more lights, their sum, the top-level T
+// layer (docs/spectral-exr.md gives the definition). A float file's stored checksum equals this for
+// the image read from it (a half file's holds the sum rounded to half).
 std::string spectral_pixel_checksum(const SpectralImage& image);
 
 // "T.550,000000nm" style channel name for a wavelength (six decimals, comma separator).

@@ -1,0 +1,279 @@
+"""Prizma from Python: spectral EXR files as numpy arrays, relighting, colour, rendering.
+
+Thin over the C++ libraries the tools use (docs/python.md): ``prizma.relight`` returns the pixels
+``prizma-relight`` writes, ``prizma.read``/``prizma.write`` are the tools' reader and writer (checksum
+included), ``prizma.render`` is ``prizma-render``'s renderer.
+
+Errors are raised as :class:`InputError` (a ``ValueError``: bad input, the tools' exit status 2) or
+:class:`RuntimeFailure` (a ``RuntimeError``: the tools' exit status 1), with the one-line message
+the tools print after ``<program>: error:``.
+"""
+
+import json as _json
+import os as _os
+import tempfile as _tempfile
+
+import numpy as _np
+
+from . import _prizma
+from ._prizma import InputError, RuntimeFailure
+
+__all__ = [
+    "Image", "InputError", "RuntimeFailure", "read", "write", "checksum", "relight", "spectrum", "xyz",
+    "lab", "delta_e2000", "named_spectra", "render", "metamer", "design_light", "version", "data_dir",
+]
+
+__version__ = _prizma.version()
+
+
+def version():
+    """The Prizma version string (with the git revision), as ``--version`` prints it."""
+    return _prizma.version()
+
+
+def data_dir():
+    """The data folder in use (CIE tables, OCIO config): $PRIZMA_DATA_DIR if set, else the build's."""
+    return _prizma.data_dir()
+
+
+class Image:
+    """A spectral image: per light, per pixel, per bin the transport under unit white light.
+
+    Attributes:
+        lights: dict, light name → float32 array of shape (height, width, bins), in the file's
+            layer order. A single-layer file has one entry (its light's name, or "default").
+        variance: dict, light name → float32 array of the same shape (variance of the mean), only
+            for the lights that have one.
+        bin_edges_nm: float64 array of the bins + 1 exact bin edges in nm.
+        attributes: dict of the file's prizma: attributes: samples, sample_range, seed, scene_hash,
+            version, wavelength_sampling, scene_path, render_options, lights (the recorded lights,
+            a list of dicts: name, direction, angularSizeDeg, spectrum) and is_prizma.
+        stats: for an image from :func:`render`, the render's statistics (paths, wall_seconds, …).
+
+    Arrays read from a file are numpy arrays over the reader's own buffers (no copy).
+    """
+
+    def __init__(self, lights, bin_edges_nm, variance=None, attributes=None):
+        self.lights = dict(lights)
+        self.bin_edges_nm = _np.asarray(bin_edges_nm, dtype=_np.float64)
+        self.variance = dict(variance or {})
+        self.attributes = dict(attributes or {})
+        self.stats = None
+
+    @classmethod
+    def _from_native(cls, d):
+        attrs = dict(d["attributes"])
+        text = attrs.pop("lights_json", "")
+        try:
+            attrs["lights"] = _json.loads(text) if text else []
+        except ValueError:
+            attrs["lights"] = text  # not JSON: kept as the file has it
+        image = cls(d["lights"], d["bin_edges_nm"], d["variance"], attrs)
+        image.stats = d.get("stats")
+        return image
+
+    def _native(self):
+        attrs = dict(self.attributes)
+        lights = attrs.pop("lights", None)
+        attrs.pop("is_prizma", None)
+        if isinstance(lights, str):
+            attrs["lights_json"] = lights
+        elif lights:
+            attrs["lights_json"] = _json.dumps(lights, separators=(",", ":"))
+        return {"bin_edges_nm": self.bin_edges_nm, "lights": self.lights, "variance": self.variance,
+                "attributes": attrs}
+
+    @property
+    def wavelengths_nm(self):
+        """Bin centres in nm (what the channel names say), float64."""
+        e = self.bin_edges_nm
+        return 0.5 * (e[:-1] + e[1:])
+
+    @property
+    def bins(self):
+        """Number of spectral bins."""
+        return len(self.bin_edges_nm) - 1
+
+    @property
+    def height(self):
+        return next(iter(self.lights.values())).shape[0] if self.lights else 0
+
+    @property
+    def width(self):
+        return next(iter(self.lights.values())).shape[1] if self.lights else 0
+
+    def __repr__(self):
+        e = self.bin_edges_nm
+        span = f"{e[0]:g}–{e[-1]:g} nm" if len(e) else "no bins"
+        return (f"<prizma.Image {self.width}×{self.height}, {self.bins} bins {span}, "
+                f"lights {list(self.lights)}>")
+
+
+def _path(p):
+    return _os.fspath(p)
+
+
+def read(path, verify=True):
+    """Reads a spectral EXR (a Prizma file or any reflective spectral EXR) into an :class:`Image`.
+
+    The pixel checksum (prizma:checksum) is verified as prizma-relight verifies it, unless
+    ``verify=False`` (prizma-relight --no-verify): a file another tool re-encoded (half, PXR24, B44)
+    keeps the attribute but not the exact values. Raises InputError naming the path for files that
+    are not spectral EXR, truncated or damaged.
+    """
+    return Image._from_native(_prizma.read(_path(path), bool(verify)))
+
+
+def write(path, image, half=False):
+    """Writes an :class:`Image` as a Prizma spectral EXR, atomically (a failure leaves no partial
+    file and never destroys an existing one), with the pixel checksum. ``half=True`` writes half
+    floats (values beyond 65504 are refused). The layout is the one prizma-render writes."""
+    _prizma.write(_path(path), image._native(), bool(half))
+
+
+def checksum(image):
+    """The prizma:checksum string of an image in memory (equal to the stored one of the file it was
+    read from)."""
+    return _prizma.checksum(image._native())
+
+
+def relight(image, lights=None, exposure=0.0, cmf="1931-2", display="sRGB", colour_space=None,
+            adapt=False, absolute=False, config=""):
+    """Relights a spectral image; returns a float32 array of shape (height, width, 3).
+
+    Args:
+        image: an :class:`Image` or the path of a spectral EXR.
+        lights: None for each light's default (the spectrum recorded in the file, else D65); a
+            spectrum spec for every light ("D65", "A*0.5", "blackbody:3200K", …); or a dict
+            {light name: spec, or None for off}: lights not named keep their default.
+        exposure: stops (EV), within ±64.
+        cmf: colour matching functions: "1931-2", "1964-10", "2012-2", "2012-10".
+        display: an OCIO display ("sRGB", "Display P3", "Rec.2020"): display-encoded values clamped
+            to [0, 1], as prizma-relight writes a PNG or TIFF before quantising. None: linear XYZ,
+            as an EXR output without --colour-space.
+        colour_space: a linear colour space of the OCIO config ("Linear sRGB", "ACEScg"): the values
+            prizma-relight writes to an EXR with --colour-space (display is then ignored).
+        adapt: Bradford adaptation from the light mix's white to D65 (--adapt).
+        absolute: absolute light units (--absolute).
+        config: an OCIO config file; empty for $OCIO or Prizma's own.
+
+    The same code as prizma-relight computes it (RelightSession): for the same settings the array
+    equals the tool's output file. The GIL is released while relighting.
+    """
+    source = image._native() if isinstance(image, Image) else _path(image)
+    if colour_space is not None:
+        display = display or "sRGB"
+    return _prizma.relight(source, lights, float(exposure), str(cmf), display, colour_space, bool(adapt),
+                           bool(absolute), _path(config))
+
+
+def spectrum(spec, wavelengths_nm=None):
+    """A spectrum from any spec string ("F11", "cc:dark-skin", "gaussian:550:20", "csv:file.csv",
+    "D65*0.5", …) → (wavelengths_nm, values), two float64 arrays: at the spectrum's own table, or at
+    ``wavelengths_nm`` when given (0 outside the table). A constant is given at 360…830 nm every 1 nm.
+    """
+    at = None if wavelengths_nm is None else _np.ascontiguousarray(wavelengths_nm, dtype=_np.float64).ravel()
+    return _prizma.spectrum(spec, at)
+
+
+def xyz(spectrum, illuminant=None, cmf="1931-2"):
+    """CIE XYZ (float64 array of 3) of a spectrum: a spec string or a pair (wavelengths_nm, values).
+
+    Without ``illuminant``: the integral of spectrum × CMF over the CMF table (no normalisation).
+    With an illuminant (spec or pair), ``spectrum`` is a reflectance: ∫R·E·cmf dλ / ∫E·ȳ dλ, so a
+    perfect white has Y = 1 (the product tabulated every 1 nm).
+    """
+    return _prizma.xyz(spectrum, illuminant, str(cmf))
+
+
+def lab(xyz, white=None):
+    """CIELAB of XYZ values (array whose last axis has 3 values), relative to ``white`` (XYZ; default
+    D65 with Y = 1)."""
+    w = None if white is None else _np.ascontiguousarray(white, dtype=_np.float64).ravel()
+    return _prizma.lab(_np.ascontiguousarray(xyz, dtype=_np.float64), w)
+
+
+def delta_e2000(lab1, lab2):
+    """CIEDE2000 colour difference (kL = kC = kH = 1) of CIELAB colours: a float for two colours, an
+    array of shape (…) for arrays of shape (…, 3) (either may be a single colour)."""
+    return _prizma.delta_e2000(_np.ascontiguousarray(lab1, dtype=_np.float64),
+                               _np.ascontiguousarray(lab2, dtype=_np.float64))
+
+
+def named_spectra():
+    """The names spectrum specs accept: named illuminants (D65, A, F11, LED-B1, …) and ColorChecker
+    patches (cc:dark-skin, …)."""
+    return _prizma.named_spectra()
+
+
+def render(scene, samples=None, threads=0, seed=None, width=None, height=None, bins=None, variance=False,
+           progress=None, samples_per_pass=0, base_dir=None):
+    """Renders a scene with prizma-render's path tracer; returns an :class:`Image`.
+
+    Args:
+        scene: a scene file (docs/scene-format.md) or a dict with its content (relative paths in
+            it resolve against ``base_dir``, default the current folder).
+        samples: samples per pixel (--spp); None for the scene's.
+        threads: worker threads, 0 for all cores. The result does not depend on it.
+        seed, width, height, bins, variance: as --seed, --width, --height, --bins, --variance.
+        progress: called after every pass with a dict (samples_done, samples_total, paths,
+            elapsed_seconds), on the calling thread. An exception it raises stops the render.
+        samples_per_pass: samples per pixel per pass (0: automatic).
+
+    Ctrl-C (SIGINT) stops the render at once: KeyboardInterrupt is raised, with the passes completed
+    so far as its ``image`` attribute (a valid render of fewer samples) when there were any. The
+    GIL is released while rendering.
+    """
+    if isinstance(scene, dict):
+        folder = _path(base_dir) if base_dir is not None else _os.getcwd()
+        fd, tmp = _tempfile.mkstemp(prefix=".prizma-scene-", suffix=".json", dir=folder)
+        try:
+            with _os.fdopen(fd, "w", encoding="utf-8") as f:
+                _json.dump(scene, f)
+            return _render(tmp, samples, threads, seed, width, height, bins, variance, progress,
+                           samples_per_pass, False)
+        except InputError as e:
+            if not str(e).startswith(tmp):
+                raise
+            # Name the dict "scene", not the temporary file it went through.
+            err = InputError("scene" + str(e)[len(tmp):])
+            err.input = "scene" + e.input[len(tmp):] if e.input.startswith(tmp) else e.input
+            err.reason = e.reason
+            raise err from None
+        finally:
+            _os.unlink(tmp)
+    return _render(_path(scene), samples, threads, seed, width, height, bins, variance, progress,
+                   samples_per_pass, True)
+
+
+def _render(path, samples, threads, seed, width, height, bins, variance, progress, samples_per_pass,
+            record_path):
+    try:
+        native = _prizma.render(path, samples, int(threads), seed, width, height, bins, bool(variance),
+                                int(samples_per_pass), progress, record_path)
+    except KeyboardInterrupt as e:
+        partial = getattr(e, "_prizma_image", None)
+        e.image = Image._from_native(partial) if partial is not None else None
+        raise
+    return Image._from_native(native)
+
+
+def metamer(albedo, match_light="D65", split_light="A", cmf="1931-2", bins=None, basis_size=20,
+            min_split_delta_e=0.5):
+    """Designs a smooth reflectance in [0, 1] with the colour of ``albedo`` under ``match_light`` and
+    as different as possible under ``split_light`` (prizma-metamer metamer). Spectra are spec
+    strings or (wavelengths_nm, values) pairs; ``bins`` a bin spec ("linear:400:700:12", default
+    1 nm over 380–780 nm). Returns a dict: reflectance (wavelengths_nm, values), delta_e_match,
+    delta_e_split."""
+    return _prizma.metamer(albedo, match_light, split_light, str(cmf), bins, int(basis_size),
+                           float(min_split_delta_e))
+
+
+def design_light(albedo_a, albedo_b, goal="reveal", reference="D65", primaries=(), cmf="1931-2", bins=None,
+                 max_power_ratio=2.0):
+    """Designs a light under which two albedos look the same (goal "hide") or as different as
+    possible (goal "reveal"), at the luminance of ``reference``, free-form or as a non-negative mix
+    of ``primaries`` (prizma-metamer light). Returns a dict: light (wavelengths_nm, values), weights,
+    delta_e (under the light), delta_e_reference."""
+    return _prizma.design_light(albedo_a, albedo_b, str(goal), reference, list(primaries), str(cmf), bins,
+                                float(max_power_ratio))

@@ -1,0 +1,645 @@
+// prizma._prizma: the C++ half of the Python module (docs/python.md). Thin over the libraries: every
+// function here calls the code the tools run (read_spectral_exr, write_spectral_exr, RelightSession,
+// DisplayTransform, render), converting between numpy arrays and the libraries' types. The public
+// API, its argument handling and docstrings live in python/prizma/__init__.py.
+//
+// Errors: spectral::InputError → prizma.InputError (a ValueError, with .input and .reason),
+// spectral::RuntimeError and other std::exception → prizma.RuntimeFailure (a RuntimeError); what()
+// is the message, the one line the tools print after "<program>: error: ".
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdint>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <new>
+#include <optional>
+#include <string>
+#include <thread>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "prizma/relight/output_image.h"
+#include "prizma/relight/relight_session.h"
+#include "prizma/render/render.h"
+#include "prizma/render/resume.h"
+#include "prizma/render/sample_range.h"
+#include "prizma/render/scene.h"
+#include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/colour.h"
+#include "prizma/spectral/colour_matching.h"
+#include "prizma/spectral/data_path.h"
+#include "prizma/spectral/display.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/light_design.h"
+#include "prizma/spectral/metamer_design.h"
+#include "prizma/spectral/spectral_exr.h"
+#include "prizma/spectral/spectrum.h"
+#include "prizma/spectral/spectrum_spec.h"
+#include "prizma/spectral/tool_main.h"
+
+namespace py = pybind11;
+namespace spectral = prizma::spectral;
+namespace relight = prizma::relight;
+namespace render = prizma::render;
+using spectral::InputError;
+
+namespace {
+
+// The exception types (owned by the module object; kept alive for the process).
+PyObject* g_input_error = nullptr;
+PyObject* g_runtime_failure = nullptr;
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// A numpy array that owns `values` (moved, not copied): the array's base is a capsule that deletes
+// the vector when numpy lets go of it.
+template <typename T>
+py::array_t<T> take_vector(std::vector<T>&& values, std::vector<py::ssize_t> shape) {
+  auto* owner = new std::vector<T>(std::move(values));
+  py::capsule base(owner, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(std::move(shape), owner->data(), base);
+}
+
+// ---------------------------------------------------------------------------------------------
+// SpectralImage ↔ Python. The Python side is a plain dict (prizma.Image wraps it):
+//   width, height, bin_edges_nm (float64 n+1), lights {name: float32 H×W×n}, variance {name: …},
+//   attributes {samples, sample_range, seed, scene_hash, version, wavelength_sampling, scene_path,
+//               render_options, lights_json, is_prizma}
+
+py::dict image_to_py(spectral::SpectralImage&& image) {
+  py::dict out;
+  const auto h = static_cast<py::ssize_t>(image.height), w = static_cast<py::ssize_t>(image.width);
+  const auto n = static_cast<py::ssize_t>(image.bins.size());
+  out["width"] = image.width;
+  out["height"] = image.height;
+  out["bin_edges_nm"] = take_vector(std::vector<double>(image.bins.edges_nm()), {n + 1});
+  py::dict lights, variance;
+  for (auto& layer : image.lights) {
+    lights[py::str(layer.name)] = take_vector(std::move(layer.data), {h, w, n});
+    if (!layer.variance.empty()) variance[py::str(layer.name)] = take_vector(std::move(layer.variance), {h, w, n});
+  }
+  out["lights"] = lights;
+  out["variance"] = variance;
+  const spectral::SpectralExrInfo& info = image.info;
+  py::dict a;
+  a["samples"] = info.samples;
+  a["sample_range"] = info.sample_range;
+  a["seed"] = info.seed;
+  a["scene_hash"] = info.scene_hash;
+  a["version"] = info.version;
+  a["wavelength_sampling"] = info.wavelength_sampling;
+  a["scene_path"] = info.scene_path;
+  a["render_options"] = info.render_options;
+  a["lights_json"] = info.lights_json;
+  a["is_prizma"] = info.is_prizma;
+  out["attributes"] = a;
+  return out;
+}
+
+template <typename T>
+T attribute_or(const py::dict& attrs, const char* key, T fallback) {
+  if (!attrs.contains(key) || attrs[key].is_none()) return fallback;
+  try {
+    return attrs[key].cast<T>();
+  } catch (const py::cast_error&) {
+    throw InputError(std::string("attributes[\"") + key + "\"]",
+                     std::string("must be ") + (std::is_same_v<T, std::string> ? "a string" : "an integer"));
+  }
+}
+
+// Copies one H×W×n array into a layer buffer, checking its shape.
+std::vector<float> layer_values(const py::handle& obj, const std::string& what, int& width, int& height, int bins) {
+  FloatArray a = FloatArray::ensure(obj);
+  if (!a) {
+    PyErr_Clear();
+    throw InputError(what, "is not an array of numbers");
+  }
+  if (a.ndim() != 3) throw InputError(what, "must be an array of shape (height, width, bins), not " + std::to_string(a.ndim()) + "-D");
+  const auto h = static_cast<int>(a.shape(0)), w = static_cast<int>(a.shape(1)), n = static_cast<int>(a.shape(2));
+  if (width == 0 && height == 0) {
+    width = w;
+    height = h;
+  }
+  if (h != height || w != width || n != bins) {
+    throw InputError(what, "has shape (" + std::to_string(h) + ", " + std::to_string(w) + ", " + std::to_string(n) +
+                               "), expected (" + std::to_string(height) + ", " + std::to_string(width) + ", " +
+                               std::to_string(bins) + ")");
+  }
+  return std::vector<float>(a.data(), a.data() + a.size());
+}
+
+spectral::SpectralImage image_from_py(const py::dict& d) {
+  spectral::SpectralImage image;
+  {
+    DoubleArray edges = DoubleArray::ensure(d["bin_edges_nm"]);
+    if (!edges || edges.ndim() != 1) {
+      PyErr_Clear();
+      throw InputError("bin_edges_nm", "must be a 1-D sequence of bin edges in nm");
+    }
+    try {
+      image.bins = spectral::BinLayout::from_edges(std::vector<double>(edges.data(), edges.data() + edges.size()));
+    } catch (const InputError& e) {
+      throw InputError("bin_edges_nm", e.reason());
+    }
+  }
+  const int bins = image.bins.size();
+  const py::dict lights = d["lights"].cast<py::dict>();
+  if (lights.empty()) throw InputError("lights", "the image has no light layers");
+  const py::dict variance = d.contains("variance") && !d["variance"].is_none() ? d["variance"].cast<py::dict>() : py::dict();
+  for (const auto& item : lights) {
+    spectral::TransportLayer layer;
+    layer.name = item.first.cast<std::string>();
+    const std::string what = "lights[\"" + layer.name + "\"]";
+    layer.data = layer_values(item.second, what, image.width, image.height, bins);
+    if (variance.contains(item.first)) {
+      layer.variance = layer_values(variance[item.first], "variance[\"" + layer.name + "\"]", image.width, image.height, bins);
+    }
+    image.lights.push_back(std::move(layer));
+  }
+  for (const auto& item : variance) {
+    if (!lights.contains(item.first)) {
+      throw InputError("variance[\"" + item.first.cast<std::string>() + "\"]", "has no light layer of that name");
+    }
+  }
+  const py::dict attrs = d.contains("attributes") && !d["attributes"].is_none() ? d["attributes"].cast<py::dict>() : py::dict();
+  spectral::SpectralExrInfo& info = image.info;
+  info.samples = attribute_or<std::int64_t>(attrs, "samples", 0);
+  info.sample_range = attribute_or<std::string>(attrs, "sample_range", "");
+  info.seed = attribute_or<std::int64_t>(attrs, "seed", 0);
+  info.scene_hash = attribute_or<std::string>(attrs, "scene_hash", "");
+  info.version = attribute_or<std::string>(attrs, "version", "");
+  info.wavelength_sampling = attribute_or<std::string>(attrs, "wavelength_sampling", "");
+  info.scene_path = attribute_or<std::string>(attrs, "scene_path", "");
+  info.render_options = attribute_or<std::string>(attrs, "render_options", "");
+  info.lights_json = attribute_or<std::string>(attrs, "lights_json", "");
+  info.is_prizma = true;
+  return image;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Files
+
+py::dict read_file(const std::string& path, bool verify) {
+  spectral::SpectralImage image;
+  {
+    py::gil_scoped_release release;
+    spectral::ExrReadOptions opts;
+    opts.verify_checksum = verify;
+    image = spectral::read_spectral_exr(path, opts);
+  }
+  return image_to_py(std::move(image));
+}
+
+void write_file(const std::string& path, const py::dict& image_dict, bool half) {
+  spectral::check_output_file(path, "path");  // as the tools check -o: a missing folder is bad input
+  spectral::SpectralImage image = image_from_py(image_dict);
+  py::gil_scoped_release release;
+  spectral::ExrWriteOptions opts;
+  opts.pixel_type = half ? spectral::ExrPixelType::Half : spectral::ExrPixelType::Float;
+  spectral::write_spectral_exr(path, image, opts);
+}
+
+std::string checksum(const py::dict& image_dict) { return spectral::spectral_pixel_checksum(image_from_py(image_dict)); }
+
+// ---------------------------------------------------------------------------------------------
+// Relighting: a RelightSession, as prizma-relight runs it.
+
+std::unique_ptr<relight::RelightSession> open_session(const py::object& source) {
+  if (py::isinstance<py::dict>(source)) {
+    spectral::SpectralImage image = image_from_py(source.cast<py::dict>());
+    py::gil_scoped_release release;
+    return std::make_unique<relight::RelightSession>(std::move(image), "image");
+  }
+  const std::string path = source.cast<std::string>();
+  py::gil_scoped_release release;
+  return std::make_unique<relight::RelightSession>(path);
+}
+
+// lights: None (the file's defaults), a str (every layer), or {name: spec or None (off)}.
+py::array_t<float> relight_image(const py::object& source, const py::object& lights, double exposure_ev,
+                                 const std::string& cmf, const std::optional<std::string>& display,
+                                 const std::optional<std::string>& colour_space, bool adapt, bool absolute,
+                                 const std::string& config) {
+  std::unique_ptr<relight::RelightSession> session = open_session(source);
+  relight::RelightSettings s = session->settings();
+  if (py::isinstance<py::str>(lights)) {
+    const relight::LightSpec light = relight::parse_light_spec(lights.cast<std::string>(), {"lights", {}});
+    std::fill(s.lights.begin(), s.lights.end(), light);
+  } else if (py::isinstance<py::dict>(lights)) {
+    for (const auto& item : lights.cast<py::dict>()) {
+      const std::string name = py::str(item.first);
+      const int l = session->light_index(name, "lights");
+      const std::string input = "lights[\"" + name + "\"]";
+      if (item.second.is_none()) {
+        s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec("off", {input, {}});
+      } else if (py::isinstance<py::str>(item.second)) {
+        s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec(item.second.cast<std::string>(), {input, {}});
+      } else {
+        throw InputError(input, "must be a spectrum spec (a string such as \"D65\" or \"A*0.5\") or None (off)");
+      }
+    }
+  } else if (!lights.is_none()) {
+    throw InputError("lights", "must be None, a spectrum spec for every light, or a dict {name: spec or None}");
+  }
+  if (!std::isfinite(exposure_ev) || std::abs(exposure_ev) > 64.0) {
+    throw InputError("exposure", "must be a finite number of stops within ±64");
+  }
+  s.relight.exposure_ev = exposure_ev;
+  s.relight.cmf = spectral::parse_observer(cmf, "cmf");
+  s.relight.adapt_to_d65 = adapt;
+  s.relight.units = absolute ? spectral::LightUnits::Absolute : spectral::LightUnits::RelativeToWhite;
+  s.output.display.config = config;
+  if (display) s.output.display.display = *display;
+  if (colour_space) s.output.display.colour_space = *colour_space;
+  session->apply(s);
+
+  const int w = session->image().width, h = session->image().height;
+  std::vector<float> pixels;
+  {
+    py::gil_scoped_release release;
+    session->relight();
+    const relight::XyzImage& xyz = session->xyz();
+    // Exactly what write_output_image writes before quantisation: PNG/TIFF the display, clamped; EXR
+    // the linear colour space, or XYZ as is (non-finite values 0 in every case).
+    if (colour_space) {
+      const auto opts = relight::transform_options(relight::OutputFormat::Exr, session->settings().output);
+      const spectral::DisplayTransform transform(opts);
+      pixels = relight::to_display(xyz, transform);
+    } else if (display) {
+      pixels = relight::to_display(xyz, session->display());
+      for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
+    } else {
+      pixels = xyz.xyz;
+      for (float& v : pixels)
+        if (!std::isfinite(v)) v = 0.0f;
+    }
+  }
+  return take_vector(std::move(pixels), {h, w, 3});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Spectra and colour
+
+spectral::Spectrum spectrum_from(const py::object& spec, const std::string& input) {
+  if (py::isinstance<py::str>(spec)) return spectral::parse_spectrum(spec.cast<std::string>(), {input, {}});
+  if (py::isinstance<py::tuple>(spec) && py::len(spec) == 2) {
+    const auto t = spec.cast<py::tuple>();
+    DoubleArray wl = DoubleArray::ensure(t[0]), v = DoubleArray::ensure(t[1]);
+    if (!wl || !v || wl.ndim() != 1 || v.ndim() != 1 || wl.size() != v.size()) {
+      PyErr_Clear();
+      throw InputError(input, "must be a spectrum spec string or a pair (wavelengths_nm, values) of equal-length 1-D arrays");
+    }
+    return spectral::Spectrum(std::vector<double>(wl.data(), wl.data() + wl.size()),
+                              std::vector<double>(v.data(), v.data() + v.size()), input);
+  }
+  throw InputError(input, "must be a spectrum spec string or a pair (wavelengths_nm, values)");
+}
+
+std::pair<py::array_t<double>, py::array_t<double>> spectrum_values(const py::object& spec,
+                                                                    const std::optional<DoubleArray>& at) {
+  const spectral::Spectrum s = spectrum_from(spec, "spectrum");
+  std::vector<double> wl;
+  if (at) {
+    wl.assign(at->data(), at->data() + at->size());
+  } else if (s.is_constant()) {
+    for (int l = static_cast<int>(spectral::BinLayout::kMinNm); l <= static_cast<int>(spectral::BinLayout::kMaxNm); ++l)
+      wl.push_back(l);
+  } else {
+    wl = s.wavelengths_nm();
+  }
+  std::vector<double> v(wl.size());
+  for (std::size_t k = 0; k < wl.size(); ++k) v[k] = s.eval(wl[k]);
+  const auto n = static_cast<py::ssize_t>(wl.size());
+  return {take_vector(std::move(wl), {n}), take_vector(std::move(v), {n})};
+}
+
+// XYZ of a spectrum: ∫ s·cmf dλ (no illuminant), or of a reflectance under an illuminant,
+// ∫ R·E·cmf dλ / ∫ E·ȳ dλ (a perfect white has Y = 1), the product R·E tabulated at 1 nm.
+py::array_t<double> xyz_of_spectrum(const py::object& spec, const py::object& illuminant, const std::string& cmf_name) {
+  const spectral::ColorMatching& cmf = spectral::ColorMatching::get(spectral::parse_observer(cmf_name, "cmf"));
+  const spectral::Spectrum s = spectrum_from(spec, "spectrum");
+  Eigen::Vector3d out;
+  if (illuminant.is_none()) {
+    out = cmf.integrate(s);
+  } else {
+    const spectral::Spectrum e = spectrum_from(illuminant, "illuminant");
+    std::vector<double> wl, prod;
+    for (double l = std::ceil(cmf.lo_nm()); l <= cmf.hi_nm(); l += 1.0) {
+      wl.push_back(l);
+      prod.push_back(s.eval(l) * e.eval(l));
+    }
+    const Eigen::Vector3d white = cmf.integrate(e);
+    if (!(white[1] > 0.0)) throw InputError("illuminant", "has no energy where the colour matching function ȳ > 0");
+    out = cmf.integrate(spectral::Spectrum(std::move(wl), std::move(prod), "spectrum × illuminant")) / white[1];
+  }
+  return take_vector(std::vector<double>{out[0], out[1], out[2]}, {3});
+}
+
+// Applies f to every 3-vector of the last axis of a (…, 3) array; returns (…, 3) or (…) results.
+py::array_t<double> lab_of(const DoubleArray& xyz_values, const std::optional<DoubleArray>& white_xyz) {
+  if (xyz_values.ndim() < 1 || xyz_values.shape(xyz_values.ndim() - 1) != 3) {
+    throw InputError("xyz", "must be an array whose last axis has 3 values (X, Y, Z)");
+  }
+  Eigen::Vector3d white = spectral::white_d65();
+  if (white_xyz) {
+    if (white_xyz->size() != 3) throw InputError("white", "must be 3 values (X, Y, Z)");
+    white = {white_xyz->data()[0], white_xyz->data()[1], white_xyz->data()[2]};
+  }
+  std::vector<double> out(static_cast<std::size_t>(xyz_values.size()));
+  const double* in = xyz_values.data();
+  for (std::size_t k = 0; k + 2 < out.size(); k += 3) {
+    const Eigen::Vector3d lab = spectral::xyz_to_lab({in[k], in[k + 1], in[k + 2]}, white);
+    out[k] = lab[0];
+    out[k + 1] = lab[1];
+    out[k + 2] = lab[2];
+  }
+  return take_vector(std::move(out), std::vector<py::ssize_t>(xyz_values.shape(), xyz_values.shape() + xyz_values.ndim()));
+}
+
+py::object delta_e2000(const DoubleArray& lab1, const DoubleArray& lab2) {
+  if (lab1.ndim() < 1 || lab1.shape(lab1.ndim() - 1) != 3) throw InputError("lab1", "must be an array whose last axis has 3 values (L*, a*, b*)");
+  if (lab2.ndim() < 1 || lab2.shape(lab2.ndim() - 1) != 3) throw InputError("lab2", "must be an array whose last axis has 3 values (L*, a*, b*)");
+  const bool same = lab1.ndim() == lab2.ndim() && std::equal(lab1.shape(), lab1.shape() + lab1.ndim(), lab2.shape());
+  const bool one1 = lab1.size() == 3, one2 = lab2.size() == 3;
+  if (!same && !one1 && !one2) throw InputError("lab2", "must have the shape of lab1 (or be a single colour)");
+  const DoubleArray& shape_of = one1 ? lab2 : lab1;
+  const std::size_t count = static_cast<std::size_t>(shape_of.size()) / 3;
+  std::vector<double> out(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    const double* a = lab1.data() + (one1 ? 0 : 3 * k);
+    const double* b = lab2.data() + (one2 ? 0 : 3 * k);
+    out[k] = spectral::delta_e2000({a[0], a[1], a[2]}, {b[0], b[1], b[2]});
+  }
+  if (shape_of.ndim() == 1) return py::float_(out[0]);
+  return take_vector(std::move(out), std::vector<py::ssize_t>(shape_of.shape(), shape_of.shape() + shape_of.ndim() - 1));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Metamers and lights: the designs prizma-metamer runs.
+
+spectral::ColourSetting colour_setting(const std::string& cmf, const std::optional<std::string>& bins) {
+  spectral::ColourSetting c;
+  c.observer = spectral::parse_observer(cmf, "cmf");
+  if (bins) c.bins = spectral::BinLayout::parse(*bins, "bins");
+  return c;
+}
+
+std::pair<py::array_t<double>, py::array_t<double>> spectrum_table(const spectral::Spectrum& s) {
+  const auto n = static_cast<py::ssize_t>(s.wavelengths_nm().size());
+  return {take_vector(std::vector<double>(s.wavelengths_nm()), {n}), take_vector(std::vector<double>(s.values()), {n})};
+}
+
+py::dict metamer(const py::object& albedo, const py::object& match_light, const py::object& split_light,
+                 const std::string& cmf, const std::optional<std::string>& bins, int basis_size, double min_split_delta_e) {
+  spectral::MetamerOptions opts;
+  opts.colour = colour_setting(cmf, bins);
+  opts.basis_size = basis_size;
+  opts.min_split_delta_e = min_split_delta_e;
+  const spectral::Spectrum a = spectrum_from(albedo, "albedo");
+  const spectral::Spectrum m = spectrum_from(match_light, "match light");
+  const spectral::Spectrum sp = spectrum_from(split_light, "split light");
+  spectral::MetamerResult r;
+  {
+    py::gil_scoped_release release;
+    r = spectral::design_metamer(a, m, sp, opts);
+  }
+  py::dict out;
+  out["reflectance"] = spectrum_table(r.reflectance);
+  out["delta_e_match"] = r.delta_e_match;
+  out["delta_e_split"] = r.delta_e_split;
+  return out;
+}
+
+py::dict design_light(const py::object& albedo_a, const py::object& albedo_b, const std::string& goal,
+                      const py::object& reference, const std::vector<py::object>& primaries, const std::string& cmf,
+                      const std::optional<std::string>& bins, double max_power_ratio) {
+  spectral::LightDesignOptions opts;
+  opts.colour = colour_setting(cmf, bins);
+  opts.max_power_ratio = max_power_ratio;
+  spectral::LightGoal g;
+  if (goal == "hide") g = spectral::LightGoal::Hide;
+  else if (goal == "reveal") g = spectral::LightGoal::Reveal;
+  else throw InputError("goal", "must be \"hide\" or \"reveal\", not \"" + goal + "\"");
+  const spectral::Spectrum a = spectrum_from(albedo_a, "albedo-a");
+  const spectral::Spectrum b = spectrum_from(albedo_b, "albedo-b");
+  const spectral::Spectrum ref = spectrum_from(reference, "reference light");
+  std::vector<spectral::Spectrum> prims;
+  for (std::size_t i = 0; i < primaries.size(); ++i) prims.push_back(spectrum_from(primaries[i], "primaries[" + std::to_string(i) + "]"));
+  spectral::LightDesignResult r;
+  {
+    py::gil_scoped_release release;
+    r = spectral::design_light(a, b, g, ref, prims, opts);
+  }
+  py::dict out;
+  out["light"] = spectrum_table(r.light);
+  const auto n_weights = static_cast<py::ssize_t>(r.weights.size());
+  out["weights"] = take_vector(std::move(r.weights), {n_weights});
+  out["delta_e"] = r.delta_e;
+  out["delta_e_reference"] = r.delta_e_reference;
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rendering: render() on a worker thread with the GIL released; the calling thread relays progress
+// to the Python callback and checks for signals (Ctrl-C) every 50 ms, setting the renderer's
+// cancellation flag when one arrives. render() then returns the passes completed so far.
+
+struct PythonError {  // a fetched Python exception (owned references), restored on the calling thread
+  PyObject *type = nullptr, *value = nullptr, *traceback = nullptr;
+  bool set() const { return type != nullptr; }
+  void fetch() { PyErr_Fetch(&type, &value, &traceback); }
+  void restore() {
+    PyErr_Restore(type, value, traceback);
+    type = value = traceback = nullptr;
+  }
+};
+
+py::dict render_scene(const std::string& scene_path, std::optional<std::int64_t> samples, int threads,
+                      std::optional<std::uint64_t> seed, std::optional<int> width, std::optional<int> height,
+                      const std::optional<std::string>& bins, bool variance, std::int64_t samples_per_pass,
+                      const py::object& progress, bool record_scene_path) {
+  render::Scene scene;
+  render::RenderOverrides given;
+  {
+    py::gil_scoped_release release;
+    scene = render::load_scene(scene_path);
+  }
+  if (width) given.width = static_cast<int>(render::scene_integer_override(std::to_string(*width), "camera.width", "width"));
+  if (height) given.height = static_cast<int>(render::scene_integer_override(std::to_string(*height), "camera.height", "height"));
+  given.seed = seed;
+  given.bins = bins;
+  given.variance = variance;
+  render::apply_overrides(scene, given, "");
+  auto& st = scene.settings;
+  if (samples) st.sample_end = render::SampleRange::starting_at(st.sample_begin, *samples, "samples").end;
+  if (threads < 0) throw InputError("threads", "must be ≥ 0 (0: all cores)");
+  if (samples_per_pass < 0) throw InputError("samples_per_pass", "must be ≥ 0 (0: automatic)");
+  if (threads > 0) st.threads = threads;
+  given.samples = render::SampleRange{st.sample_begin, st.sample_end};
+
+  std::atomic<bool> cancel{false};
+  std::mutex mutex;
+  std::condition_variable wake;
+  bool done = false;
+  std::vector<render::RenderProgress> reports;  // not yet relayed, in order
+  std::exception_ptr failure;
+  spectral::SpectralImage image;
+  render::RenderStats stats;
+  render::RenderCallbacks cb;
+  cb.cancel = &cancel;
+  cb.samples_per_pass = samples_per_pass;
+  cb.progress = [&](const render::RenderProgress& p) {
+    const std::lock_guard lock(mutex);
+    reports.push_back(p);
+    wake.notify_all();
+  };
+
+  PythonError pending;
+  bool interrupted_by_signal = false;
+  {
+    py::gil_scoped_release release;
+    std::thread worker([&] {
+      try {
+        image = render::render(scene, cb, &stats);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      const std::lock_guard lock(mutex);
+      done = true;
+      wake.notify_all();
+    });
+    for (bool finished = false; !finished;) {
+      std::vector<render::RenderProgress> batch;
+      {
+        std::unique_lock lock(mutex);
+        wake.wait_for(lock, std::chrono::milliseconds(50), [&] { return done || !reports.empty(); });
+        batch.swap(reports);
+        finished = done;
+      }
+      if (pending.set()) continue;  // cancelled: wait for the worker, call nothing more
+      const py::gil_scoped_acquire acquire;
+      for (const render::RenderProgress& report : batch) {
+        if (progress.is_none() || pending.set()) break;
+        py::dict d;
+        d["samples_done"] = report.samples_done;
+        d["samples_total"] = report.samples_total;
+        d["paths"] = report.paths;
+        d["elapsed_seconds"] = report.elapsed_seconds;
+        PyObject* r = PyObject_CallOneArg(progress.ptr(), d.ptr());
+        if (r == nullptr) {
+          pending.fetch();
+          cancel.store(true);
+        } else {
+          Py_DECREF(r);
+        }
+      }
+      if (pending.set()) continue;
+      if (PyErr_CheckSignals() != 0) {
+        pending.fetch();
+        interrupted_by_signal = true;
+        cancel.store(true);
+      }
+    }
+    worker.join();
+  }
+  if (failure && !pending.set()) std::rethrow_exception(failure);
+  if (pending.set()) {
+    // Ctrl-C: the exception carries the passes completed so far (a valid, shorter render).
+    interrupted_by_signal = interrupted_by_signal || PyErr_GivenExceptionMatches(pending.type, PyExc_KeyboardInterrupt);
+    if (interrupted_by_signal && !failure && image.width > 0) {
+      PyErr_NormalizeException(&pending.type, &pending.value, &pending.traceback);
+      image.info.render_options = render::overrides_to_json(given);
+      py::dict partial = image_to_py(std::move(image));
+      if (pending.value != nullptr) PyObject_SetAttrString(pending.value, "_prizma_image", partial.ptr());
+    }
+    pending.restore();
+    throw py::error_already_set();
+  }
+  if (record_scene_path) image.info.scene_path = std::filesystem::absolute(scene.source).lexically_normal().string();
+  image.info.render_options = render::overrides_to_json(given);
+  py::dict out = image_to_py(std::move(image));
+  py::dict s;
+  s["paths"] = stats.paths;
+  s["paths_in_volume"] = stats.paths_in_volume;
+  s["collisions"] = stats.collisions;
+  s["nan_or_inf_count"] = stats.nan_or_inf_count;
+  s["samples_completed"] = stats.samples_completed;
+  s["interrupted"] = stats.interrupted;
+  s["wall_seconds"] = stats.wall_seconds;
+  out["stats"] = s;
+  return out;
+}
+
+void translate_exception(std::exception_ptr p) {
+  try {
+    if (p) std::rethrow_exception(p);
+  } catch (const InputError& e) {
+    PyObject* inst = PyObject_CallFunction(g_input_error, "s", e.what());
+    if (inst == nullptr) return;  // the call set its own error
+    PyObject_SetAttrString(inst, "input", py::str(e.input()).ptr());
+    PyObject_SetAttrString(inst, "reason", py::str(e.reason()).ptr());
+    PyErr_SetObject(g_input_error, inst);
+    Py_DECREF(inst);
+  } catch (const std::bad_alloc&) {
+    throw;  // pybind11: MemoryError
+  } catch (const py::error_already_set&) {
+    throw;
+  } catch (const py::builtin_exception&) {
+    throw;
+  } catch (const std::exception& e) {
+    PyErr_SetString(g_runtime_failure, e.what());
+  }
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_prizma, m) {
+  m.doc() = "C++ half of the prizma module; use the functions of `prizma` (docs/python.md).";
+  g_input_error = PyErr_NewExceptionWithDoc(
+      "prizma.InputError",
+      "Bad input (a file, a spec, an argument): the error the tools report with exit status 2. A ValueError; "
+      "str(e) is the one-line message, e.input names what was wrong, e.reason says why.",
+      PyExc_ValueError, nullptr);
+  g_runtime_failure = PyErr_NewExceptionWithDoc(
+      "prizma.RuntimeFailure",
+      "A failure that is not the input's fault (I/O after validation, a library): the tools' exit status 1. "
+      "A RuntimeError.",
+      PyExc_RuntimeError, nullptr);
+  m.add_object("InputError", py::handle(g_input_error));
+  m.add_object("RuntimeFailure", py::handle(g_runtime_failure));
+  py::register_exception_translator(translate_exception);
+
+  m.def("version", [] { return spectral::prizma_version(); });
+  m.def("data_dir", [] { return spectral::data_dir().string(); });
+  m.def("read", &read_file, py::arg("path"), py::arg("verify") = true);
+  m.def("write", &write_file, py::arg("path"), py::arg("image"), py::arg("half") = false);
+  m.def("checksum", &checksum, py::arg("image"));
+  m.def("relight", &relight_image, py::arg("source"), py::arg("lights"), py::arg("exposure"), py::arg("cmf"),
+        py::arg("display"), py::arg("colour_space"), py::arg("adapt"), py::arg("absolute"), py::arg("config"));
+  m.def("spectrum", &spectrum_values, py::arg("spec"), py::arg("wavelengths_nm") = py::none());
+  m.def("xyz", &xyz_of_spectrum, py::arg("spectrum"), py::arg("illuminant"), py::arg("cmf"));
+  m.def("lab", &lab_of, py::arg("xyz"), py::arg("white") = py::none());
+  m.def("delta_e2000", &delta_e2000, py::arg("lab1"), py::arg("lab2"));
+  m.def("named_spectra", [] {
+    std::vector<std::string> names = spectral::named_illuminants();
+    for (const auto& p : spectral::colorchecker_patches()) names.push_back(p);
+    return names;
+  });
+  m.def("metamer", &metamer, py::arg("albedo"), py::arg("match_light"), py::arg("split_light"), py::arg("cmf"),
+        py::arg("bins"), py::arg("basis_size"), py::arg("min_split_delta_e"));
+  m.def("design_light", &design_light, py::arg("albedo_a"), py::arg("albedo_b"), py::arg("goal"),
+        py::arg("reference"), py::arg("primaries"), py::arg("cmf"), py::arg("bins"), py::arg("max_power_ratio"));
+  m.def("render", &render_scene, py::arg("scene_path"), py::arg("samples"), py::arg("threads"), py::arg("seed"),
+        py::arg("width"), py::arg("height"), py::arg("bins"), py::arg("variance"), py::arg("samples_per_pass"),
+        py::arg("progress"), py::arg("record_scene_path"));
+}

@@ -1,0 +1,91 @@
+"""Files other tools read right: preview R, G, B channels, re-encoded files, chromaticities."""
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+import prizma
+from conftest import run_tool
+
+oiio = pytest.importorskip("OpenImageIO")
+
+
+def channels(path, names):
+    inp = oiio.ImageInput.open(str(path))
+    assert inp, oiio.geterror()
+    try:
+        spec = inp.spec()
+        index = [spec.channelnames.index(n) for n in names]
+        everything = inp.read_image(0, 0, 0, spec.nchannels, "float")
+        return everything[:, :, index], spec
+    finally:
+        inp.close()
+
+
+def oiiotool(*args):
+    exe = shutil.which("oiiotool")
+    if not exe:
+        pytest.skip("oiiotool not installed (Debian openimageio-tools)")
+    subprocess.run([exe, *map(str, args)], check=True, capture_output=True, timeout=60)
+
+
+def test_preview_channels_are_the_default_relight_in_linear_srgb(tiny_exr):
+    rgb, spec = channels(tiny_exr, ["R", "G", "B"])
+    assert rgb.max() > 0.01
+    ours = prizma.relight(tiny_exr, colour_space="Linear sRGB")  # what prizma-relight makes by default
+    np.testing.assert_allclose(rgb, ours, rtol=1e-4, atol=1e-6)
+    # Readers of the spectral layout ignore them: the lights and bins are as before.
+    image = prizma.read(tiny_exr)
+    assert list(image.lights) == ["side", "sky"] and image.bins == 6
+
+
+def test_written_images_carry_the_preview_too(tiny_exr, tmp_path):
+    image = prizma.read(tiny_exr)
+    out = tmp_path / "again.exr"
+    prizma.write(out, image)
+    np.testing.assert_array_equal(channels(out, ["R", "G", "B"])[0], channels(tiny_exr, ["R", "G", "B"])[0])
+
+
+@pytest.mark.parametrize("how,named,atol", [
+    (["-d", "half", "--compression", "b44"], "the lossy B44, Prizma writes PIZ", None),  # 4×4 blocks, ±25 %
+    (["--compression", "pxr24"], "the lossy PXR24, Prizma writes PIZ", 0.01),
+    (["-d", "half"], "it was written by OpenImageIO", 0.01),
+])
+def test_reencoded_file_is_named_as_such_and_read_with_no_verify(tiny_exr, tmp_path, how, named, atol):
+    copy = tmp_path / "reencoded.exr"
+    oiiotool(tiny_exr, *how, "-o", copy)
+    proc = run_tool("relight", copy, "-o", tmp_path / "x.png", check=False)
+    assert proc.returncode == 2, proc.stderr
+    assert "pixel data do not match prizma:checksum: the file was probably re-encoded by another tool" in proc.stderr
+    assert named in proc.stderr and "--no-verify" in proc.stderr
+    with pytest.raises(prizma.InputError, match="probably re-encoded"):
+        prizma.read(copy)
+    run_tool("relight", copy, "--no-verify", "-o", tmp_path / "x.png")
+    back = prizma.read(copy, verify=False)
+    original = prizma.read(tiny_exr)
+    np.testing.assert_array_equal(back.bin_edges_nm, original.bin_edges_nm)  # exact edges survive
+    for name in original.lights:
+        assert np.isfinite(back.lights[name]).all()
+        if atol is not None:
+            np.testing.assert_allclose(back.lights[name], original.lights[name], rtol=0.05, atol=atol)
+
+
+def test_exr_outputs_carry_chromaticities(tiny_exr, tmp_path):
+    xyz_out, srgb_out, aces_out = tmp_path / "xyz.exr", tmp_path / "srgb.exr", tmp_path / "aces.exr"
+    run_tool("relight", tiny_exr, "-o", xyz_out)
+    run_tool("relight", tiny_exr, "--colour-space", "Linear sRGB", "-o", srgb_out)
+    run_tool("relight", tiny_exr, "--colour-space", "ACEScg", "-o", aces_out)
+    np.testing.assert_allclose(channels(xyz_out, ["X"])[1].getattribute("chromaticities"),
+                               [1, 0, 0, 1, 0, 0, 1 / 3, 1 / 3], atol=1e-7)
+    np.testing.assert_allclose(channels(srgb_out, ["R"])[1].getattribute("chromaticities"),
+                               [0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290], atol=2e-4)
+    # ACEScg: the tag takes the file's RGB back to the relit XYZ (the standard RGB → XYZ from xy).
+    rgb, spec = channels(aces_out, ["R", "G", "B"])
+    c = np.array(spec.getattribute("chromaticities"), dtype=np.float64).reshape(4, 2)
+    xyz_of = lambda xy: np.array([xy[0] / xy[1], 1.0, (1 - xy[0] - xy[1]) / xy[1]])
+    prim = np.stack([xyz_of(c[k]) for k in range(3)], axis=1)
+    scale = np.linalg.solve(prim, xyz_of(c[3]))
+    to_xyz = prim * scale
+    xyz = prizma.relight(tiny_exr, display=None)
+    np.testing.assert_allclose(rgb @ to_xyz.T, xyz, rtol=1e-3, atol=1e-5)
