@@ -26,6 +26,13 @@ install(TARGETS ${_prizma_tools} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COM
 # build this target. A new installed target (the Python module) adds itself with add_dependencies.
 add_custom_target(prizma-installed)
 add_dependencies(prizma-installed ${_prizma_tools})
+# The image module the tools load for PNG/TIFF/JPEG (imageio/; installed into lib/prizma) and the
+# Python module (python/; its own install rule): both are installed, so both are built.
+foreach(module prizma_imageio prizma_python)
+  if(TARGET ${module})
+    add_dependencies(prizma-installed ${module})
+  endif()
+endforeach()
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/spectra ${PROJECT_SOURCE_DIR}/data/ocio ${PROJECT_SOURCE_DIR}/data/scenes
         DESTINATION ${PRIZMA_INSTALL_DATADIR} COMPONENT data)
@@ -33,5 +40,5 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/spectra ${PROJECT_SOURCE_DIR}/data/
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT docs)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT docs)
 
-# The Python module (`import prizma`): its own CMakeLists has its install() rule (COMPONENT python)
-# and add_dependencies(prizma-installed <module>); scripts/install then builds and installs it too.
+# The Python module (`import prizma`): its own CMakeLists has its install() rule (COMPONENT python);
+# prizma-installed depends on it (above), so scripts/install builds and installs it too.

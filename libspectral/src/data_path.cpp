@@ -1,5 +1,7 @@
 #include "prizma/spectral/data_path.h"
 
+#include <dlfcn.h>
+
 #include <cstdlib>
 #include <system_error>
 
@@ -33,6 +35,19 @@ std::filesystem::path data_dir() {
     installed = exe.parent_path().parent_path() / "share" / "prizma";
 #endif
     if (is_dir(installed)) return installed;
+  }
+  // 2b. This code inside a shared object that is not the executable: the Python module, installed
+  //     as <prefix>/lib/python3.X/site-packages/prizma/_prizma.so → <prefix>/share/prizma.
+  {
+    static const char anchor = 0;
+    Dl_info info{};
+    if (::dladdr(&anchor, &info) != 0 && info.dli_fname != nullptr && *info.dli_fname != '\0') {
+      const std::filesystem::path so = std::filesystem::absolute(std::filesystem::path(info.dli_fname), ec);
+      if (!ec && so != exe) {
+        const auto prefix = so.parent_path().parent_path().parent_path().parent_path().parent_path();
+        if (is_dir(prefix / "share" / "prizma")) return prefix / "share" / "prizma";
+      }
+    }
   }
   // 3. The source tree's data/ recorded at build time (running from the build tree).
 #ifdef PRIZMA_SOURCE_DATA_DIR

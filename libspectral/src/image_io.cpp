@@ -42,6 +42,19 @@ std::vector<fs::path> candidates() {
     out.push_back(dir / kModuleFile);
     out.push_back(dir.parent_path() / "lib" / "prizma" / kModuleFile);
   }
+  // This code inside a shared object that is not the executable: the Python module, installed as
+  // <prefix>/lib/python3.X/site-packages/prizma/_prizma.so (or lib/python3/dist-packages), whose
+  // image module is <prefix>/lib/prizma/ three folders up.
+  static const char anchor = 0;
+  Dl_info info{};
+  if (::dladdr(&anchor, &info) != 0 && info.dli_fname != nullptr && *info.dli_fname != '\0') {
+    std::error_code ec;
+    const fs::path so = fs::absolute(fs::path(info.dli_fname), ec).parent_path();
+    if (!ec && so != dir) {
+      out.push_back(so / kModuleFile);
+      out.push_back(so.parent_path().parent_path().parent_path() / "prizma" / kModuleFile);
+    }
+  }
 #ifdef PRIZMA_IMAGE_IO_BUILD_PATH
   out.emplace_back(PRIZMA_IMAGE_IO_BUILD_PATH);
 #endif

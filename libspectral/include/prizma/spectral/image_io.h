@@ -8,6 +8,8 @@
 //   $PRIZMA_IMAGE_IO_MODULE (a path: for tests and unusual installs)
 //   <folder of the executable>/libprizma_imageio.so
 //   <folder of the executable>/../lib/prizma/libprizma_imageio.so   (installed layout)
+//   when this code is in another shared object (the Python module …/prizma/_prizma.so): that
+//   folder, and <that folder>/../../../prizma/ (<prefix>/lib/prizma/ from lib/python3.X/site-packages/prizma/)
 //   the build tree's module (the path it was built at)
 // A module that cannot be loaded is a RuntimeError ("cannot load the image module <path>: <why>";
 // "out of memory loading the image module …" when the address space ran out), exit 1.
