@@ -2,13 +2,16 @@
 // reading it with OpenImageIO.
 #include "prizma/render/environment_map.h"
 
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/image_io.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/stderr_capture.h"
 
@@ -29,17 +32,6 @@ std::string num(double v) {
   s.precision(6);
   s << v;
   return s.str();
-}
-
-// The last error OpenImageIO holds (the reader's, else the global one), on one line; clearing both.
-std::string oiio_error(OIIO::ImageInput* in) {
-  std::string e = in != nullptr ? in->geterror() : std::string();
-  const std::string global = OIIO::geterror();
-  if (e.empty()) e = global;
-  for (char& c : e)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!e.empty() && e.back() == ' ') e.pop_back();
-  return e.empty() ? "unknown error" : e;
 }
 
 // Index of the interval of a CDF (size n + 1, cdf[0] = 0, cdf[n] = total) that holds x.
@@ -95,15 +87,17 @@ EnvironmentMap EnvironmentMap::load(const std::filesystem::path& path, double ro
   std::error_code ec;
   const auto file_bytes = static_cast<long long>(std::filesystem::file_size(path, ec));
   // libpng and OpenEXR may print their errors on stderr first: captured into the one line.
+  // Read through the image module (OpenImageIO, loaded on first use: image_io.h); libpng and
+  // OpenEXR may print their errors on stderr first: captured into the one line.
   spectral::StderrCapture open_capture;
-  auto in = OIIO::ImageInput::open(file);
+  std::string open_error;
+  const std::unique_ptr<spectral::PictureReader> in = spectral::open_picture(file, open_error);
   const std::string open_printed = open_capture.finish();
   if (!in) {
-    const std::string e = oiio_error(nullptr);
+    const std::string& e = open_error;
     throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("image library", open_printed, e));
   }
-  const OIIO::ImageSpec spec = in->spec();
-  const int w = spec.width, h = spec.height, nc = spec.nchannels;
+  const int w = in->width(), h = in->height(), nc = in->channels();
   if (w < 1 || h < 1 || nc < 1) throw InputError(input, "image " + file + " is empty");
   const long long pixels = static_cast<long long>(w) * h;
   if (pixels > kMaxEnvironmentPixels) {
@@ -111,22 +105,27 @@ EnvironmentMap EnvironmentMap::load(const std::filesystem::path& path, double ro
                                 " pixels; an environment map has at most " + std::to_string(kMaxEnvironmentPixels) +
                                 " pixels");
   }
-  const long long decoded = pixels * nc * static_cast<long long>(spec.format.size());
+  const long long decoded = pixels * nc * static_cast<long long>(in->channel_bytes());
   if (ec || decoded > kMaxEnvironmentExpansion * std::max(file_bytes, 1LL)) {
     throw InputError(input, "image " + file + " claims " + std::to_string(w) + "×" + std::to_string(h) + "×" +
                                 std::to_string(nc) + " pixels, more than its " + std::to_string(file_bytes) +
                                 " bytes can hold (truncated or corrupt)");
   }
-  const int channels = std::min(nc, 3);
-  std::vector<float> px(static_cast<std::size_t>(pixels) * channels);
+  std::vector<float> all(static_cast<std::size_t>(pixels) * nc);
   spectral::StderrCapture read_capture;
-  const bool read_ok = in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, px.data());
+  std::string read_error;
+  const bool read_ok = in->read_float(all.data(), read_error);
   const std::string read_printed = read_capture.finish();
   if (!read_ok) {
-    const std::string e = oiio_error(in.get());
+    const std::string& e = read_error;
     throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("image library", read_printed, e));
   }
-  in->close();
+  // The first three channels (R, G, B) or the one channel of a grey image.
+  const int channels = std::min(nc, 3);
+  std::vector<float> px(static_cast<std::size_t>(pixels) * channels);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(pixels); ++i)
+    for (int c = 0; c < channels; ++c) px[i * channels + c] = all[i * nc + c];
+  all = std::vector<float>();
   std::vector<float> lum(static_cast<std::size_t>(pixels));
   for (std::size_t i = 0; i < lum.size(); ++i) {
     const float* p = px.data() + i * channels;
