@@ -9,9 +9,9 @@ endif()
 # prizma-render -D: overrides typed by the field, checked like the file, errors naming the key.
 set(_tiny ${PRIZMA_E2E_DIR}/render/tiny.json)
 prizma_render_e2e(define "${_tiny}|-D|camera.width=5|-Dcamera.height=3|-D|lights.side.spectrum=A|-D|seed=7|-D|bins=linear:400:700:3|-v|--threads|1|-o|define.exr"
-  MUST_EXIST define.exr ERR_REGEX "5×3, 3 bins linear:400:700:3, samples 0:4, seed 7.*light side .*default spectrum A")
+  MUST_EXIST define.exr ERR_REGEX "5×3, 3 bins linear:400:700:3, samples 0:4, seed 7.*light side: .*default spectrum A")
 prizma_render_e2e(define_index "${_tiny}|-D|lights[1].spectrum=D50|-D|materials.core.albedo=0.5|-v|-o|define_index.exr"
-  MUST_EXIST define_index.exr ERR_REGEX "light sky .*default spectrum D50")
+  MUST_EXIST define_index.exr ERR_REGEX "light sky: .*default spectrum D50")
 prizma_render_e2e(define_normalization "${_tiny}|-D|normalization={\"min\": 0, \"max\": 255}|-q|-o|define_norm.exr"
   MUST_EXIST define_norm.exr)
 prizma_render_e2e(define_both_spellings "${_tiny}|-D|normalization=\"auto\"|-D|normalisation=\"auto\"|-o|bad.exr"
