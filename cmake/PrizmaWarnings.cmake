@@ -28,3 +28,12 @@ if(PRIZMA_SANITIZE OR PRIZMA_FUZZ)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
+
+# prizma_sanitizer_ignorelist(FILE...): the sanitizers skip the third-party header code listed in
+# cmake/sanitizer-ignorelist.txt in these sources (clang only; call it in the folder that adds them).
+function(prizma_sanitizer_ignorelist)
+  if((PRIZMA_SANITIZE OR PRIZMA_FUZZ) AND CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    set_source_files_properties(${ARGN} PROPERTIES COMPILE_OPTIONS
+                                "-fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/cmake/sanitizer-ignorelist.txt")
+  endif()
+endfunction()
