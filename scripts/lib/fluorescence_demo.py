@@ -71,7 +71,7 @@ def dilate(mask, steps):
     return out
 
 
-def label_masks(tools, base, dyed, tissue, out, size, spp, seed):
+def label_masks(tools, base, dyed, out, size, spp, seed):
     """(inclusion, surroundings) pixel masks from a two-bin label render."""
     label = json.loads(json.dumps(base))
     label["bins"] = "edges:380,580,780"
@@ -150,10 +150,9 @@ def main():
     dyed = next((i for i, m in enumerate(mats) if "fluorescence" in m), None)
     if dyed is None or len(mats) != 2:
         raise pd.DemoFailure("fluorescent_phantom.json must have two materials, one with a fluorescence field")
-    tissue = 1 - dyed
 
     # 1. Regions.
-    inclusion, ring = label_masks(tools, base, dyed, tissue, out, args.size, args.spp, args.seed + 2)
+    inclusion, ring = label_masks(tools, base, dyed, out, args.size, args.spp, args.seed + 2)
     np.save(out / "masks.npy", np.stack([inclusion, ring]))
 
     # 2. The render, and the control without the dye.
