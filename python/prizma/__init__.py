@@ -36,6 +36,13 @@ def data_dir():
     return _prizma.data_dir()
 
 
+def _input_error(input, reason):
+    """An InputError as the C++ side makes them: str() "input: reason", with .input and .reason."""
+    e = InputError(f"{input}: {reason}")
+    e.input, e.reason = input, reason
+    return e
+
+
 class Image:
     """A spectral image: per light, per pixel, per bin the transport under unit white light.
 
@@ -49,16 +56,65 @@ class Image:
             version, wavelength_sampling, scene_path, render_options, lights (the recorded lights,
             a list of dicts: name, direction, angularSizeDeg, spectrum) and is_prizma.
         stats: for an image from :func:`render`, the render's statistics (paths, wall_seconds, …).
+        reradiation: dict, light name → float32 array (height, width, pairs): the bispectral
+            (fluorescence) terms M[out][in] of the pairs in ``reradiation_pairs``; empty for a file
+            without fluorescence. Every light has the same pairs (docs/fluorescence.md).
+        reradiation_pairs: int32 array (pairs, 2) of (in, out) bin indices, sorted, in ≠ out.
 
     Arrays read from a file are numpy arrays over the reader's own buffers (no copy).
     """
 
-    def __init__(self, lights, bin_edges_nm, variance=None, attributes=None):
+    def __init__(self, lights, bin_edges_nm, variance=None, attributes=None, reradiation=None,
+                 reradiation_pairs=None):
+        """``reradiation``: the bispectral terms, either {light: (height, width, pairs)} with
+        ``reradiation_pairs``, or without them {light: (height, width, bins, bins)} matrices M[out][in]
+        (see :meth:`set_reradiation_matrices`)."""
         self.lights = dict(lights)
         self.bin_edges_nm = _np.asarray(bin_edges_nm, dtype=_np.float64)
         self.variance = dict(variance or {})
         self.attributes = dict(attributes or {})
         self.stats = None
+        self.reradiation = {}
+        self.reradiation_pairs = _np.zeros((0, 2), dtype=_np.int32)
+        if reradiation_pairs is not None:
+            self.reradiation = dict(reradiation or {})
+            self.reradiation_pairs = _np.asarray(reradiation_pairs, dtype=_np.int32).reshape(-1, 2)
+        elif reradiation:
+            self.set_reradiation_matrices(reradiation)
+
+    def set_reradiation_matrices(self, matrices):
+        """Sets the bispectral terms from one re-radiation matrix per light: {light: array of shape
+        (height, width, bins, bins)}, M[y, x, out, in] the radiance in bin ``out`` per unit light in bin
+        ``in`` (bin averages, as prizma-render writes them). The diagonal must be zero: it is the
+        light's layer in ``lights``. The pairs kept are the off-diagonal entries that are non-zero in
+        some pixel of some light (every light gets the same pairs, as the layout requires)."""
+        n = self.bins
+        mats = {}
+        used = _np.zeros((n, n), dtype=bool)
+        for name, m in matrices.items():
+            m = _np.asarray(m, dtype=_np.float32)
+            if m.ndim != 4 or m.shape[2:] != (n, n):
+                raise _input_error(f'reradiation["{name}"]', f"must have shape (height, width, {n}, {n}), not {m.shape}")
+            diag = _np.diagonal(m, axis1=2, axis2=3)
+            if _np.any(diag != 0):
+                raise _input_error(f'reradiation["{name}"]', "has a non-zero diagonal (that is the light's T layer)")
+            used |= _np.any(m != 0, axis=(0, 1))
+            mats[name] = m
+        outs, ins = _np.nonzero(used)  # used[out, in]
+        order = _np.lexsort((outs, ins))  # by (in, out)
+        ins, outs = ins[order], outs[order]
+        self.reradiation_pairs = _np.stack([ins, outs], axis=1).astype(_np.int32).reshape(-1, 2)
+        self.reradiation = {name: _np.ascontiguousarray(m[:, :, outs, ins]) for name, m in mats.items()}
+
+    def reradiation_matrix(self, light):
+        """The light's re-radiation matrix, float32 (height, width, bins, bins), M[y, x, out, in]; zero
+        outside the stored pairs and on the diagonal."""
+        n = self.bins
+        m = _np.zeros((self.height, self.width, n, n), dtype=_np.float32)
+        if len(self.reradiation_pairs):
+            ins, outs = self.reradiation_pairs[:, 0], self.reradiation_pairs[:, 1]
+            m[:, :, outs, ins] = self.reradiation[light]
+        return m
 
     @classmethod
     def _from_native(cls, d):
@@ -68,7 +124,8 @@ class Image:
             attrs["lights"] = _json.loads(text) if text else []
         except ValueError:
             attrs["lights"] = text  # not JSON: kept as the file has it
-        image = cls(d["lights"], d["bin_edges_nm"], d["variance"], attrs)
+        image = cls(d["lights"], d["bin_edges_nm"], d["variance"], attrs, d.get("reradiation"),
+                    d.get("reradiation_pairs"))
         image.stats = d.get("stats")
         return image
 
@@ -81,7 +138,7 @@ class Image:
         elif lights:
             attrs["lights_json"] = _json.dumps(lights, separators=(",", ":"))
         return {"bin_edges_nm": self.bin_edges_nm, "lights": self.lights, "variance": self.variance,
-                "attributes": attrs}
+                "attributes": attrs, "reradiation": self.reradiation, "reradiation_pairs": self.reradiation_pairs}
 
     @property
     def wavelengths_nm(self):

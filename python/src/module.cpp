@@ -90,6 +90,18 @@ py::dict image_to_py(spectral::SpectralImage&& image) {
   }
   out["lights"] = lights;
   out["variance"] = variance;
+  // Bispectral terms (docs/fluorescence.md): the (in, out) bin pairs, and per light H×W×pairs.
+  const auto np = static_cast<py::ssize_t>(image.reradiation.size());
+  std::vector<std::int32_t> pairs;
+  for (const spectral::BinPair& pr : image.reradiation) {
+    pairs.push_back(pr.in);
+    pairs.push_back(pr.out);
+  }
+  out["reradiation_pairs"] = take_vector(std::move(pairs), {np, 2});
+  py::dict reradiation;
+  for (auto& layer : image.lights)
+    if (np > 0) reradiation[py::str(layer.name)] = take_vector(std::move(layer.reradiation), {h, w, np});
+  out["reradiation"] = reradiation;
   const spectral::SpectralExrInfo& info = image.info;
   py::dict a;
   a["samples"] = info.samples;
@@ -170,6 +182,38 @@ spectral::SpectralImage image_from_py(const py::dict& d) {
     if (!lights.contains(item.first)) {
       throw InputError("variance[\"" + item.first.cast<std::string>() + "\"]", "has no light layer of that name");
     }
+  }
+  // Bispectral terms: reradiation_pairs (P×2 bin indices, in then out) and reradiation {light: H×W×P};
+  // the writer checks the pairs (in range, off the diagonal, sorted, the same for every light).
+  if (d.contains("reradiation_pairs") && !d["reradiation_pairs"].is_none()) {
+    using IntArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+    IntArray pairs = IntArray::ensure(d["reradiation_pairs"]);
+    if (!pairs || (pairs.size() != 0 && !(pairs.ndim() == 2 && pairs.shape(1) == 2))) {
+      PyErr_Clear();
+      throw InputError("reradiation_pairs", "must be an array of (in, out) bin index pairs, shape (pairs, 2)");
+    }
+    for (py::ssize_t k = 0; k + 1 < pairs.size(); k += 2) {
+      const std::int64_t in = pairs.data()[k], o = pairs.data()[k + 1];
+      if (in < 0 || o < 0 || in >= bins || o >= bins)
+        throw InputError("reradiation_pairs", "pair (" + std::to_string(in) + ", " + std::to_string(o) + ") is outside the " +
+                                                  std::to_string(bins) + " bins");
+      image.reradiation.push_back({static_cast<int>(in), static_cast<int>(o)});
+    }
+  }
+  const py::dict reradiation =
+      d.contains("reradiation") && !d["reradiation"].is_none() ? d["reradiation"].cast<py::dict>() : py::dict();
+  const int np = static_cast<int>(image.reradiation.size());
+  for (const auto& item : reradiation)
+    if (!lights.contains(item.first))
+      throw InputError("reradiation[\"" + item.first.cast<std::string>() + "\"]", "has no light layer of that name");
+  if (np > 0) {
+    for (auto& layer : image.lights) {
+      const std::string what = "reradiation[\"" + layer.name + "\"]";
+      if (!reradiation.contains(py::str(layer.name))) throw InputError(what, "missing: every light needs its bispectral terms");
+      layer.reradiation = layer_values(reradiation[py::str(layer.name)], what, image.width, image.height, np);
+    }
+  } else if (!reradiation.empty()) {
+    throw InputError("reradiation", "given without reradiation_pairs");
   }
   const py::dict attrs = d.contains("attributes") && !d["attributes"].is_none() ? d["attributes"].cast<py::dict>() : py::dict();
   spectral::SpectralExrInfo& info = image.info;

@@ -75,11 +75,13 @@ PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi
     m_fluorescent.push_back(fl ? 1 : 0);
     m_any_fluorescence = m_any_fluorescence || fl;
     m_fl_emission.push_back(spectral::Spectrum::constant(0.0));
+    m_fl_excitation.emplace_back();
     if (fl) {
       const double area = fluorescence_emission_area(mat.fluorescence.emission);
       if (!(area > 0.0) || !std::isfinite(area) || !(mat.fluorescence.quantum_yield <= 1.0))
         throw spectral::InputError("medium", "material \"" + mat.name + "\": fluorescence needs an emission of positive area and q in [0, 1]");
       m_fl_emission.back() = mat.fluorescence.emission.scaled(1.0 / area);
+      m_fl_excitation.back() = ExcitationSampler(mat.fluorescence.absorption, lambda_lo_nm, lambda_hi_nm);
     }
     if (mat.fluorescent) m_wavelength_independent = false;
     if (!mat.albedo.is_constant() || !mat.sigma_t_per_unit.is_constant() || !mat.anisotropy.is_constant() ||
@@ -184,6 +186,8 @@ void PathTracer::evaluate_fluorescence(int m, PathScratch& s) const {
     fi[i] = static_cast<float>(static_cast<double>(s.width_nm[i]) * sf * l);
     big_lambda += fi[i];
   }
+  // One lane (--wavelength-sampling single): λin is drawn over the whole range, Λ = ∫ σf·λ dλ.
+  if (n == 1) big_lambda = m_fl_excitation[m].total();
   s.fl_lambda_sum[m] = big_lambda;
   if (!m_fluorescent[m] || !(big_lambda > 0.0)) {
     std::fill(fo, fo + n, 0.0f);
@@ -439,7 +443,8 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
         const float xi = rng.uniform() * c;
         if (xi < ma) return;  // absorbed: no emission, the path ends
         if (xi < ma + ms) {
-          if constexpr (kLanes != 1) {  // one lane: the factor is exactly 1 (analog tracking)
+          if (kLanes != 1 || mf > 0.0f) {  // one lane: exactly 1 (analog tracking) unless a fluorescent
+                                           // event adds d·Φ to the sum c
             const float k = c / (mu * ms);
             for (int i = 0; i < n; ++i) w[i] *= ss[i] * k;
           }
@@ -462,7 +467,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
           isotropic = true;
           break;
         }
-        if constexpr (kLanes != 1) {
+        if (kLanes != 1 || mf > 0.0f) {
           const float k = c / (mu * mn);
           for (int i = 0; i < n; ++i) w[i] *= sn[i] * k;
         }
@@ -583,6 +588,29 @@ void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch&
   const int n = s.lanes;
   float* w = s.weight.data();
   const float* fo = s.fl_out.data() + static_cast<std::size_t>(m) * n;
+  if (n == 1) {
+    // One wavelength per path (--wavelength-sampling single): the path's wavelength becomes λin,
+    // drawn with density σf(λ)·λ/Λ (ExcitationSampler; Φ holds Λ), its weight that draw's. The out
+    // side keeps the event's factor a = w·d·Φ·c/(μ̄·mf); the bin of λin is read off the wavelength.
+    const float event = w[0] * density * fo[0] * k;
+    const ExcitationSampler::Draw draw = m_fl_excitation[m].sample(rng.uniform_double());
+    s.lambda_nm[0] = static_cast<float>(draw.lambda_nm);
+    if (++s.path_id == 0) {  // every material is evaluated anew at the new wavelength
+      std::fill(s.material_stamp.begin(), s.material_stamp.end(), 0u);
+      s.path_id = 1;
+    }
+    if (!s.fl_active) {
+      s.fl_a[0] = event;
+      std::fill(s.fl_environment.begin(), s.fl_environment.end(), 0.0f);
+      std::fill(s.fl_emission.begin(), s.fl_emission.end(), 0.0f);
+      std::fill(s.fl_directional.begin(), s.fl_directional.end(), 0.0f);
+      s.fl_active = true;
+      w[0] = static_cast<float>(draw.weight);
+    } else {
+      w[0] = event * static_cast<float>(draw.weight);
+    }
+    return;
+  }
   const double old_sum = s.fl_lambda_sum[m];
   float total = 0.0f;  // later events: Σ_i a'_i
   if (!s.fl_active) {

@@ -84,9 +84,14 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   // Fluorescence (docs/fluorescence.md): the bispectral pairs the scene can fill; nothing of it
   // runs for a scene without fluorescence.
   const FluorescenceLayout fluor = fluorescence_layout(scene.medium, bins);
-  if (fluor.any && mode == LaneMode::Single)
-    throw InputError("wavelength_sampling", "fluorescence is rendered with spectral-tracking only (all bins per path); "
-                                            "single does not change a path's wavelength yet");
+  // Single: the path's one wavelength changes at a fluorescent event (PathTracer::fluoresce); the
+  // pair (camera bin, bin of the last wavelength) gets the term. pair_index[out·nb + in]: its pair.
+  std::vector<int> pair_index;
+  if (fluor.any && mode == LaneMode::Single) {
+    pair_index.assign(static_cast<std::size_t>(nb) * nb, -1);
+    for (std::size_t k = 0; k < fluor.pairs.size(); ++k)
+      pair_index[static_cast<std::size_t>(fluor.pairs[k].out) * nb + fluor.pairs[k].in] = static_cast<int>(k);
+  }
 
   // Where each light's per-lane radiance comes from: the environment (−1), the medium's emission
   // (−2) or a directional light.
@@ -115,7 +120,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   std::vector<double> total_sum(adaptive ? pixels : 0, 0.0), total_sq(adaptive ? pixels : 0, 0.0);
   std::vector<std::int64_t> count(pixels, 0);
   std::vector<char> converged(pixels, 0);
-  const bool fluorescent = fluor.any && mode == LaneMode::AllBins;
+  const bool fluorescent = fluor.any && mode != LaneMode::Replicated;
   const std::size_t np = fluor.pairs.size();
   const std::size_t per_pixel_fl = fluorescent && st.fold_light_spectra ? 0 : static_cast<std::size_t>(nl) * np;
   std::vector<double> sum_fl(fluorescent ? pixels * per_pixel_fl : 0, 0.0);
@@ -124,8 +129,8 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
     ThreadState t;
     tracer.prepare(t.path, lanes);
     t.value.assign(per_pixel, 0.0);
-    if (fluorescent) {
-      t.value_fl.assign(per_pixel_fl, 0.0);
+    if (fluorescent) t.value_fl.assign(per_pixel_fl, 0.0);
+    if (fluorescent && mode == LaneMode::AllBins) {
       for (int i = 0; i < nb; ++i) {
         t.path.lo_nm[i] = static_cast<float>(bins.lo_nm(i));
         t.path.width_nm[i] = static_cast<float>(bins.width_nm(i));
@@ -151,11 +156,29 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   // pairs into vf, diagonal ones into the sample's transport (ts.value). Folded lights (test mode)
   // weigh the in side by the light at λin and everything goes to the diagonal (the radiance at out).
   // False when a value is not finite.
-  auto add_fluorescent_sample = [&](const PathScratch& ps, double* v, double* vf) -> bool {
+  auto add_fluorescent_sample = [&](const PathScratch& ps, int bin, double* v, double* vf) -> bool {
     std::fill(vf, vf + per_pixel_fl, 0.0);
     if (!ps.fl_active) return true;
     bool ok = true;
     const float* a = ps.fl_a.data();
+    if (mode == LaneMode::Single) {
+      // One lane: out = the camera bin (drawn with probability 1/n: weight n), in = the bin of the
+      // path's last wavelength (σf > 0 there, so the pair is in the layout).
+      const int in = bins.find(ps.lambda_nm[0]);
+      const int k = in < 0 ? -1 : in == bin ? -2 : pair_index[static_cast<std::size_t>(bin) * nb + in];
+      for (int l = 0; l < nl; ++l) {
+        const float* src = source[l] == -2 ? ps.fl_emission.data()
+                           : source[l] < 0 ? ps.fl_environment.data()
+                                           : ps.fl_directional.data() + source[l];
+        const double val = static_cast<double>(a[0]) * src[0] * nb * (fold.empty() ? 1.0 : fold[l].eval(ps.lambda_nm[0]));
+        ok = ok && std::isfinite(val);
+        if (k == -2 || (k >= 0 && !fold.empty()))
+          v[static_cast<std::size_t>(l) * nb + bin] += val;
+        else if (k >= 0)
+          vf[static_cast<std::size_t>(l) * np + static_cast<std::size_t>(k)] = val;
+      }
+      return ok;
+    }
     for (int l = 0; l < nl; ++l) {
       const float* src = source[l] == -2 ? ps.fl_emission.data()
                          : source[l] < 0 ? ps.fl_environment.data()
@@ -236,7 +259,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
         }
         for (int i = 0; i < nb; ++i) finite = finite && std::isfinite(out[i]);
       }
-      if (fluorescent) finite = add_fluorescent_sample(ps, v, ts.value_fl.data()) && finite;
+      if (fluorescent) finite = add_fluorescent_sample(ps, bin, v, ts.value_fl.data()) && finite;
       if (!finite) {
         // Never let a NaN/Inf reach the image: count it, take the sample as 0.
         ++ts.nan_or_inf;

@@ -51,7 +51,7 @@ endif()
 
 if(TARGET prizma-metamer AND TARGET prizma-render AND TARGET prizma-relight)
   get_filename_component(_prizma_scripts ${PRIZMA_E2E_DIR}/../../scripts ABSOLUTE)
-  foreach(demo metamerism-demo scattering-demo reveal-demo)
+  foreach(demo metamerism-demo scattering-demo reveal-demo fluorescence-demo)
     add_test(NAME demo.${demo} COMMAND ${_prizma_scripts}/${demo} ${PRIZMA_E2E_WORK}/${demo} --small)
     set_tests_properties(demo.${demo} PROPERTIES LABELS demo TIMEOUT 600 ENVIRONMENT
       "PRIZMA_RENDER=$<TARGET_FILE:prizma-render>;PRIZMA_RELIGHT=$<TARGET_FILE:prizma-relight>;PRIZMA_METAMER=$<TARGET_FILE:prizma-metamer>;PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR};MPLCONFIGDIR=${PRIZMA_E2E_WORK}/${demo}/.mpl")

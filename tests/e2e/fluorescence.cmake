@@ -1,6 +1,6 @@
 # End-to-end tests of fluorescence (docs/fluorescence.md): data/scenes/fluorescent_dye.json rendered
 # small in two shards, merged (the bispectral channels too), relit under a violet LED; a fluorescent
-# scene with --wavelength-sampling single is one error line, exit 2, no file.
+# scene with --wavelength-sampling single renders and relights too.
 if(NOT TARGET prizma-render OR NOT TARGET prizma-relight)
   return()
 endif()
@@ -35,6 +35,8 @@ prizma_fluorescence_e2e(merge $<TARGET_FILE:prizma-render> "merge|dye0.exr|dye1.
   MUST_EXIST dye.exr ERR_REGEX "samples 0:4" FIXTURES_REQUIRED fluorescence_shards FIXTURES_SETUP fluorescence_merged)
 prizma_fluorescence_e2e(relight $<TARGET_FILE:prizma-relight> "dye.exr|--light|key=LED-V1|--light|sky=off|-o|dye_violet.png"
   MUST_EXIST dye_violet.png FIXTURES_REQUIRED fluorescence_merged)
-prizma_fluorescence_e2e(single_refused $<TARGET_FILE:prizma-render>
-  "${_fl_scene}|--wavelength-sampling|single|-o|single.exr|${_small}" EXPECT_RC 2 MUST_NOT_EXIST single.exr
-  ERR_REGEX "wavelength_sampling: fluorescence is rendered with spectral-tracking only" ERR_LINES 1)
+prizma_fluorescence_e2e(single $<TARGET_FILE:prizma-render>
+  "${_fl_scene}|--wavelength-sampling|single|--spp|4|-o|single.exr|${_small}" MUST_EXIST single.exr
+  FIXTURES_SETUP fluorescence_single)
+prizma_fluorescence_e2e(single_relight $<TARGET_FILE:prizma-relight> "single.exr|--light|key=LED-V1|--light|sky=off|-o|single_violet.png"
+  MUST_EXIST single_violet.png FIXTURES_REQUIRED fluorescence_single)

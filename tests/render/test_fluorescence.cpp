@@ -198,10 +198,83 @@ TEST(Fluorescence, RelightingTheBispectralImageEqualsFoldingTheLightIn) {
   EXPECT_GT(red, 0.0);
 }
 
-TEST(Fluorescence, SingleWavelengthSamplingIsRefused) {
-  Scene s = dye_box(dye_material(0.0, 1.0, 1.0), {0, 0, 1}, 1);
+// --wavelength-sampling single: one wavelength per path, changed at the re-emission (λin drawn ∝
+// σf·λ), the pair (camera bin, λin's bin) filled. The same closed forms as above, and the
+// spectral-tracking render of the same scene, within 3 combined standard errors (fixed seeds). The
+// single render gets 6× the samples (each path estimates one out bin of six).
+void expect_single_matches(Scene s, std::int64_t spp, double q, double sigma_f_scale,
+                           const std::function<double(double)>& f) {
+  const spectral::SpectralImage spectral_img = render(s);
   s.settings.wavelength_sampling = WavelengthSampling::Single;
-  EXPECT_THROW(render(s), spectral::InputError);
+  s.settings.sample_end = 6 * spp;
+  const spectral::SpectralImage single_img = render(s);
+  ASSERT_EQ(single_img.reradiation, spectral_img.reradiation);
+  const PairEstimate a = pair_average(single_img, 0), b = pair_average(spectral_img, 0);
+  for (std::size_t k = 0; k < single_img.reradiation.size(); ++k) {
+    const double want = closed_form(single_img.bins, single_img.reradiation[k], q, sigma_f_scale, f);
+    EXPECT_NEAR(a.mean[k], want, kSe * a.se[k] + 1e-7) << "pair " << k << " se " << a.se[k];
+    EXPECT_NEAR(a.mean[k], b.mean[k], kSe * std::hypot(a.se[k], b.se[k]) + 1e-7) << "pair " << k;
+    EXPECT_LT(a.se[k], 0.1 * want);  // precise enough to tell a wrong factor
+  }
+  // The diagonal as well (the part of the paths before any re-emission).
+  const auto da = testing::pixel_average(single_img, 0), db = testing::pixel_average(spectral_img, 0);
+  for (int i = 0; i < single_img.bins.size(); ++i)
+    EXPECT_NEAR(da.mean[i], db.mean[i], kSe * std::hypot(da.se[i], db.se[i]) + 1e-7) << "bin " << i;
+}
+
+TEST(Fluorescence, SingleWavelengthSamplingConservesPhotonsLikeSpectralTracking) {
+  expect_single_matches(dye_box(dye_material(0.0, 1.0, 1.0), {0, 0, 1}, 256), 256, 1.0, 1.0,
+                        [](double sf) { return 1.0 - std::exp(-sf); });
+}
+
+TEST(Fluorescence, SingleWavelengthSamplingMatchesTheThinSlabForm) {
+  const double st = 0.3, scale = 0.1, q = 0.6;
+  expect_single_matches(dye_box(dye_material(st, scale, q), {0, 0, -1}, 512), 512, q, scale,
+                        [&](double sf) { return std::exp(-st) * (1.0 - std::exp(-sf)); });
+}
+
+// Scattering, a diagonal term (absorption and emission overlap in one bin) and folded lights: the
+// single render relit equals the single render with the light folded in, and the spectral one.
+TEST(Fluorescence, SingleWavelengthSamplingRelitEqualsSpectralTracking) {
+  Material m = dye_material(0.2, 1.0, 0.8);
+  m.albedo = Spectrum::constant(0.5);
+  m.fluorescence.emission = Spectrum({430.0, 500.0, 650.0, 700.0}, {0.0, 1.0, 2.0, 1.0});  // overlaps σf in 450–500
+  Scene s = box_scene(m, 4, 8, 1024);
+  s.lights.push_back(testing::directional_light("uv", {0.3, 0.2, 1}));
+  const spectral::SpectralImage spectral_img = render(s);
+  s.settings.wavelength_sampling = WavelengthSampling::Single;
+  s.settings.sample_end = 6 * 1024;
+  const spectral::SpectralImage single_img = render(s);
+  ASSERT_EQ(single_img.reradiation, spectral_img.reradiation);
+  ASSERT_FALSE(fluorescence_layout(s.medium, s.settings.bins).diagonal.empty());
+  for (int l = 0; l < 2; ++l) {
+    const PairEstimate a = pair_average(single_img, l), b = pair_average(spectral_img, l);
+    for (std::size_t k = 0; k < single_img.reradiation.size(); ++k)
+      EXPECT_NEAR(a.mean[k], b.mean[k], kSe * std::hypot(a.se[k], b.se[k]) + 1e-7) << "light " << l << " pair " << k;
+    const auto da = testing::pixel_average(single_img, l), db = testing::pixel_average(spectral_img, l);
+    for (int i = 0; i < single_img.bins.size(); ++i)
+      EXPECT_NEAR(da.mean[i], db.mean[i], kSe * std::hypot(da.se[i], db.se[i]) + 1e-7) << "light " << l << " bin " << i;
+  }
+  // Folded (the same random numbers): T·ē + M·ē of the single render equals its folded render.
+  s.lights[0].spectrum_spec = "box:450:650";
+  s.lights[1].spectrum_spec = "box:400:500*2";
+  const spectral::SpectralImage bi = render(s);
+  s.settings.fold_light_spectra = true;
+  const spectral::SpectralImage folded = render(s);
+  const int nb = bi.bins.size();
+  std::vector<double> relit(bi.pixel_count() * nb, 0.0);
+  for (int l = 0; l < 2; ++l) {
+    spectral::SpecContext ctx;
+    const std::vector<double> e = spectral::parse_spectrum(s.lights[l].spectrum_spec, ctx).bin_averages(bi.bins);
+    for (std::size_t px = 0; px < bi.pixel_count(); ++px)
+      for (int i = 0; i < nb; ++i) relit[px * nb + i] += bi.lights[l].data[px * nb + i] * e[i];
+    spectral::add_reradiated(bi, l, e, relit);
+  }
+  for (std::size_t px = 0; px < bi.pixel_count(); ++px)
+    for (int i = 0; i < nb; ++i) {
+      const double want = folded.lights[0].data[px * nb + i] + folded.lights[1].data[px * nb + i];
+      EXPECT_NEAR(relit[px * nb + i], want, 2e-4 * (1.0 + std::abs(want))) << "pixel " << px << " bin " << i;
+    }
 }
 
 // The scene field: the happy path and one-line errors naming the field.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "prizma/render/camera.h"
+#include "prizma/render/fluorescence.h"
 #include "prizma/render/light_sampler.h"
 #include "prizma/render/majorant_grid.h"
 #include "prizma/render/rng.h"
@@ -122,6 +123,7 @@ class PathTracer {
   std::vector<char> m_emits;       // per material: emission > 0 somewhere
   std::vector<char> m_fluorescent;  // per material: fluoresces with q > 0
   std::vector<spectral::Spectrum> m_fl_emission;  // per material: emission normalised to unit area
+  std::vector<ExcitationSampler> m_fl_excitation;  // per material: λin of a one-lane path's event
   bool m_any_fluorescence = false;
   bool m_any_emission = false;
   int m_emission_light = -1;
