@@ -106,12 +106,12 @@ void trace_batch(const pr::Scene& scene, const pr::PathTracer& tracer, pr::PathS
     const double u = rng.uniform_double();
     if (scratch.lanes == 1) {
       const int b = std::min(nb - 1, static_cast<int>(rng.uniform_double() * nb));
-      scratch.lambda_nm[0] = static_cast<float>(bins.lo_nm(b) + u * bins.width_nm(b));
+      scratch.in.lambda_nm[0] = static_cast<float>(bins.lo_nm(b) + u * bins.width_nm(b));
     } else {
-      for (int i = 0; i < nb; ++i) scratch.lambda_nm[i] = static_cast<float>(bins.lo_nm(i) + u * bins.width_nm(i));
+      for (int i = 0; i < nb; ++i) scratch.in.lambda_nm[i] = static_cast<float>(bins.lo_nm(i) + u * bins.width_nm(i));
     }
     tracer.trace(ray, rng, scratch);
-    benchmark::DoNotOptimize(scratch.environment.data());
+    benchmark::DoNotOptimize(scratch.out.environment.data());
   }
   out.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
   out.paths += count;

@@ -4,7 +4,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 
+#include "lanes.h"
+#include "majorant_sampler.h"
 #include "prizma/render/fluorescence.h"
 #include "prizma/render/phase.h"
 #include "prizma/spectral/error.h"
@@ -27,6 +30,16 @@ constexpr double kFloatMax = std::numeric_limits<float>::max();
 template <int kLanes>
 int lane_count(const PathScratch& s) {
   return kLanes > 0 ? kLanes : s.lanes;
+}
+
+// The lanes of a per-lane array, or of row `row` of a [row][lanes] array.
+template <int kLanes>
+Lanes<kLanes> lanes_of(std::vector<float>& v, int n, std::size_t row = 0) {
+  return Lanes<kLanes>(v.data() + row * static_cast<std::size_t>(n), n);
+}
+template <int kLanes>
+ConstLanes<kLanes> lanes_of(const std::vector<float>& v, int n, std::size_t row = 0) {
+  return ConstLanes<kLanes>(v.data() + row * static_cast<std::size_t>(n), n);
 }
 
 }  // namespace
@@ -114,33 +127,31 @@ void PathTracer::prepare(PathScratch& s, int lanes) const {
   const std::size_t n = static_cast<std::size_t>(lanes);
   const std::size_t nm = m_medium->materials.size();
   s.lanes = lanes;
-  s.lambda_nm.assign(n, 0.0f);
-  s.sigma_t.assign(nm * n, 0.0f);
-  s.albedo.assign(nm * n, 0.0f);
-  s.g.assign(nm * n, 0.0f);
-  s.emission_le.assign(nm * n, 0.0f);
-  s.material_stamp.assign(nm, 0);
-  s.path_id = 0;
-  for (auto* v : {&s.weight, &s.transmittance, &s.phase, &s.sigma_a, &s.sigma_s, &s.sigma_n, &s.environment, &s.emission})
-    v->assign(n, 0.0f);
-  s.directional.assign(m_lights.size() * n, 0.0f);
-  s.width_nm.assign(n, 0.0f);
-  s.lo_nm.assign(n, 0.0f);
-  s.fl_active = false;
+  s.in.lambda_nm.assign(n, 0.0f);
+  s.in.width_nm.assign(n, 0.0f);
+  s.in.lo_nm.assign(n, 0.0f);
+  MaterialCache& c = s.cache;
+  c.lambda_nm.assign(n, 0.0f);
+  for (auto* v : {&c.sigma_t, &c.albedo, &c.g, &c.emission_le}) v->assign(nm * n, 0.0f);
+  c.stamp.assign(nm, 0);
+  c.path_id = 0;
+  PathWork& w = s.work;
+  for (auto* v : {&w.weight, &w.transmittance, &w.phase, &w.sigma_a, &w.sigma_s, &w.sigma_n}) v->assign(n, 0.0f);
+  PathResult& out = s.out;
+  out.environment.assign(n, 0.0f);
+  out.emission.assign(n, 0.0f);
+  out.directional.assign(m_lights.size() * n, 0.0f);
+  out.fl_active = false;
   const bool any_fluorescent = std::any_of(m_medium->materials.begin(), m_medium->materials.end(),
                                            [](const Material& m) { return m.fluorescent; });
   if (any_fluorescent) {
-    s.fl_out.assign(nm * n, 0.0f);
-    s.fl_in.assign(nm * n, 0.0f);
-    s.fl_lambda_sum.assign(nm, 0.0);
-    for (auto* v : {&s.zero_g, &s.fl_a, &s.fl_environment, &s.fl_emission}) v->assign(n, 0.0f);
-    s.fl_directional.assign(m_lights.size() * n, 0.0f);
+    c.fl_out.assign(nm * n, 0.0f);
+    c.fl_in.assign(nm * n, 0.0f);
+    c.fl_lambda_sum.assign(nm, 0.0);
+    w.zero_g.assign(n, 0.0f);
+    for (auto* v : {&out.fl_a, &out.fl_environment, &out.fl_emission}) v->assign(n, 0.0f);
+    out.fl_directional.assign(m_lights.size() * n, 0.0f);
   }
-}
-
-bool PathTracer::hits_medium(const Ray& ray) const {
-  double t0, t1;
-  return intersect_box(ray, m_medium->bounds_min, m_medium->bounds_max, t0, t1);
 }
 
 void PathTracer::evaluate_material(int m, PathScratch& s) const {
@@ -148,19 +159,19 @@ void PathTracer::evaluate_material(int m, PathScratch& s) const {
   // voxel lookup and a few multiplies.
   const Material& mat = m_medium->materials[m];
   const int n = s.lanes;
-  float* st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
-  float* al = s.albedo.data() + static_cast<std::size_t>(m) * n;
-  float* g = s.g.data() + static_cast<std::size_t>(m) * n;
-  float* le = s.emission_le.data() + static_cast<std::size_t>(m) * n;
+  float* st = s.cache.sigma_t.data() + static_cast<std::size_t>(m) * n;
+  float* al = s.cache.albedo.data() + static_cast<std::size_t>(m) * n;
+  float* g = s.cache.g.data() + static_cast<std::size_t>(m) * n;
+  float* le = s.cache.emission_le.data() + static_cast<std::size_t>(m) * n;
   for (int i = 0; i < n; ++i) {
-    const double l = s.lambda_nm[i];
+    const double l = s.cache.lambda_nm[i];
     st[i] = static_cast<float>(std::max(0.0, mat.sigma_t_per_unit.eval(l)));
     al[i] = static_cast<float>(std::clamp(mat.albedo.eval(l), 0.0, 1.0));
     g[i] = static_cast<float>(std::clamp(mat.anisotropy.eval(l), -0.9999, 0.9999));
     if (m_emits[m]) le[i] = static_cast<float>(std::max(0.0, mat.emission.eval(l)));
   }
   if (mat.fluorescent) evaluate_fluorescence(m, s);
-  s.material_stamp[m] = s.path_id;
+  s.cache.stamp[m] = s.cache.path_id;
 }
 
 void PathTracer::evaluate_fluorescence(int m, PathScratch& s) const {
@@ -172,23 +183,23 @@ void PathTracer::evaluate_fluorescence(int m, PathScratch& s) const {
   // Φ_i·Σ_j p_j·L̄(λj) with Φ_i = q·ρ(λi)/λi·Λ, p_j = Δj·σf(λj)·λj/Λ and Λ = Σ_j Δj·σf(λj)·λj.
   const Material& mat = m_medium->materials[m];
   const int n = s.lanes;
-  float* st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
-  float* al = s.albedo.data() + static_cast<std::size_t>(m) * n;
-  float* fo = s.fl_out.data() + static_cast<std::size_t>(m) * n;
-  float* fi = s.fl_in.data() + static_cast<std::size_t>(m) * n;
+  float* st = s.cache.sigma_t.data() + static_cast<std::size_t>(m) * n;
+  float* al = s.cache.albedo.data() + static_cast<std::size_t>(m) * n;
+  float* fo = s.cache.fl_out.data() + static_cast<std::size_t>(m) * n;
+  float* fi = s.cache.fl_in.data() + static_cast<std::size_t>(m) * n;
   double big_lambda = 0.0;
   for (int i = 0; i < n; ++i) {
-    const double l = s.lambda_nm[i];
+    const double l = s.cache.lambda_nm[i];
     const auto sf = static_cast<float>(std::max(0.0, mat.fluorescence.absorption.eval(l)));
     const float st0 = st[i];
     st[i] = st0 + sf;
     al[i] = st[i] > 0.0f ? al[i] * (st0 / st[i]) : 0.0f;
-    fi[i] = static_cast<float>(static_cast<double>(s.width_nm[i]) * sf * l);
+    fi[i] = static_cast<float>(static_cast<double>(s.in.width_nm[i]) * sf * l);
     big_lambda += fi[i];
   }
   // One lane (--wavelength-sampling single): λin is drawn over the whole range, Λ = ∫ σf·λ dλ.
   if (n == 1) big_lambda = m_fl_excitation[m].total();
-  s.fl_lambda_sum[m] = big_lambda;
+  s.cache.fl_lambda_sum[m] = big_lambda;
   if (!m_fluorescent[m] || !(big_lambda > 0.0)) {
     std::fill(fo, fo + n, 0.0f);
     std::fill(fi, fi + n, 0.0f);
@@ -196,7 +207,7 @@ void PathTracer::evaluate_fluorescence(int m, PathScratch& s) const {
   }
   const double q = mat.fluorescence.quantum_yield;
   for (int i = 0; i < n; ++i) {
-    const double l = s.lambda_nm[i];
+    const double l = s.cache.lambda_nm[i];
     fo[i] = static_cast<float>(q * std::max(0.0, m_fl_emission[m].eval(l)) / l * big_lambda);
     fi[i] = static_cast<float>(fi[i] / big_lambda);
   }
@@ -281,14 +292,33 @@ void PathTracer::trace(const Ray& ray, Rng& rng, PathScratch& s) const {
     trace_lanes<0>(ray, rng, s);
 }
 
+// The state of a path between its events.
+template <int kLanes>
+struct PathTracer::PathState {
+  int n;             // lanes
+  Lanes<kLanes> w;   // throughput per lane
+  // Where light seen from here on goes: the diagonal results, or after a fluorescent event the in
+  // side of the rank-one term (out.fl_*).
+  float* env;
+  float* em;
+  float* dir_out;
+  Eigen::Vector3d pos, dir;
+  double t_enter = 0.0, t_exit = 0.0;  // the current ray's interval inside the box
+  double phase_pdf = 0.0;  // density of dir's last draw from the phase function (0: camera ray)
+  int material = 0;        // at the last scattering
+  bool isotropic = false;  // the last event was a fluorescent re-emission (phase 1/4π)
+  std::int64_t step_limit = 0;  // collisions + shadow steps at which the path is abandoned
+
+  Lanes<kLanes> lanes(float* p) const { return Lanes<kLanes>(p, n); }
+};
+
 void PathTracer::add_escape(const Eigen::Vector3d& dir, double phase_pdf, const float* w, float* lights_out,
                             PathScratch& s) const {
   const int n = s.lanes;
   for (int k : m_escape_lights) {
     const auto radiance = static_cast<float>(m_lights[k].escape_radiance(dir, phase_pdf));
     if (!(radiance > 0.0f)) continue;
-    float* __restrict out = lights_out + static_cast<std::size_t>(k) * n;
-    for (int i = 0; i < n; ++i) out[i] += w[i] * radiance;
+    Lanes<0>(lights_out + static_cast<std::size_t>(k) * n, n) += ConstLanes<0>(w, n) * radiance;
   }
 }
 
@@ -298,279 +328,261 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
   // Ratio tracking (Novák, Selle, Jarosz 2014) against the cell majorants, every lane at once:
   // T *= 1 − σt/μ̄ at each tentative collision, with Russian roulette once T is small.
   const int n = lane_count<kLanes>(s);
-  float* __restrict T = s.transmittance.data();
-  for (int i = 0; i < n; ++i) T[i] = 1.0f;
+  const Lanes<kLanes> T = lanes_of<kLanes>(s.work.transmittance, n);
+  T = 1.0f;
   const Ray ray{origin, dir};
   double t_enter, t_exit;
   if (!intersect_box(ray, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) return;
   t_exit = std::min(t_exit, t_max);  // a light inside or before the box: only the medium up to it
   if (!(t_exit > t_enter)) return;
-  MajorantTraversal walk(m_grid, ray, t_enter, t_exit);
-  MajorantTraversal::Segment seg;
   const std::int64_t step_limit = s.counters.shadow_steps + kMaxPathSteps;
-  while (walk.next(seg)) {
-    ++s.counters.majorant_cells;
-    if (seg.majorant <= 0.0f) continue;
-    const float inv_mu = 1.0f / seg.majorant;
-    double t = seg.t0;
-    for (;;) {
-      t -= std::log(rng.uniform()) * inv_mu;
-      if (t >= seg.t1) break;
-      if (++s.counters.shadow_steps > step_limit) {
-        for (int i = 0; i < n; ++i) T[i] = kAbandoned;
-        return;
+  sample_majorant(m_grid, ray, t_enter, t_exit, rng, s.counters.majorant_cells, [&](const TentativeCollision& tc) {
+    if (++s.counters.shadow_steps > step_limit) {
+      T = kAbandoned;
+      return false;
+    }
+    std::uint16_t m;
+    float d;
+    lookup(tc.p, m, d);
+    if (m == Medium::kEmpty || d <= 0.0f) return true;
+    if (s.cache.stamp[m] != s.cache.path_id) evaluate_material(m, s);
+    const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
+    const float scale = d * tc.inv_mu;
+    T *= lane_max(0.0f, 1.0f - scale * sigma_t);
+    if (T.max() < kTransmittanceRrThreshold) {
+      if (rng.uniform() < kTransmittanceRrStop) {
+        T = 0.0f;
+        return false;
       }
-      std::uint16_t m;
-      float d;
-      lookup(origin + t * dir, m, d);
-      if (m == Medium::kEmpty || d <= 0.0f) continue;
-      if (s.material_stamp[m] != s.path_id) evaluate_material(m, s);
-      const float* __restrict st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
-      const float scale = d * inv_mu;
-      float tmax = 0.0f;
-      for (int i = 0; i < n; ++i) {
-        T[i] *= std::max(0.0f, 1.0f - scale * st[i]);
-        tmax = std::max(tmax, T[i]);
+      T *= 1.0f / (1.0f - kTransmittanceRrStop);
+    }
+    return true;
+  });
+}
+
+template <int kLanes>
+PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, PathScratch& s) const {
+  // Delta tracking with spectral tracking's event probabilities (Kutz et al. 2017, "max"
+  // history-aware scheme): P_e ∝ max_i |w_i σ_e,i| for e ∈ {absorb, scatter, null}, and each
+  // lane's weight multiplied by σ_e,i / (μ̄ P_e). With one lane this is analog delta tracking.
+  const int n = v.n;
+  const Lanes<kLanes>& w = v.w;
+  const Lanes<kLanes> sa = lanes_of<kLanes>(s.work.sigma_a, n);
+  const Lanes<kLanes> ss = lanes_of<kLanes>(s.work.sigma_s, n);
+  const Lanes<kLanes> sn = lanes_of<kLanes>(s.work.sigma_n, n);
+  FlightEnd end = FlightEnd::Escaped;
+  const Ray ray{v.pos, v.dir};
+  sample_majorant(m_grid, ray, v.t_enter, v.t_exit, rng, s.counters.majorant_cells, [&](const TentativeCollision& tc) {
+    if (++s.counters.collisions + s.counters.shadow_steps > v.step_limit) {
+      end = FlightEnd::Abandoned;
+      return false;
+    }
+    std::uint16_t m;
+    float d;
+    lookup(tc.p, m, d);
+    if (m == Medium::kEmpty || d <= 0.0f) return true;  // σt = 0: a null collision of weight 1
+    if (s.cache.stamp[m] != s.cache.path_id) evaluate_material(m, s);
+    const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
+    const ConstLanes<kLanes> albedo = lanes_of<kLanes>(std::as_const(s.cache.albedo), n, m);
+    const float mu = tc.mu;
+    ss = d * sigma_t * albedo;
+    sa = d * sigma_t - ss;
+    sn = lane_max(0.0f, mu - d * sigma_t);
+    const float ma = max_over(w * sa, n), ms = max_over(w * ss, n), mn = max_over(w * sn, n);
+    float mf = 0.0f;
+    if (m_fluorescent[m]) {
+      // The fluorescent source is a fourth event, of "coefficient" d·Φ_i (evaluate_fluorescence);
+      // σf itself is in σa (absorbed at the lane's own wavelength).
+      mf = max_over(w * d * lanes_of<kLanes>(std::as_const(s.cache.fl_out), n, m), n);
+    }
+    if (m_emits[m]) {
+      // Emission, pbrt-v4's estimator: at every tentative collision, before the event is chosen,
+      // w_i σa,i Le,i / μ̄ (collisions come at rate μ̄, so the sum estimates ∫ T σa Le ds; the
+      // absorption event then contributes nothing and the null and scattering events keep their
+      // weights, which stays unbiased whatever the event probabilities).
+      v.lanes(v.em) += w * sa * lanes_of<kLanes>(std::as_const(s.cache.emission_le), n, m) * tc.inv_mu;
+    }
+    const float c = ma + ms + mf + mn;  // mf = 0 without fluorescence: the sum as before
+    if (!(c > 0.0f)) {
+      end = FlightEnd::Absorbed;
+      return false;
+    }
+    const float xi = rng.uniform() * c;
+    if (xi < ma) {  // absorbed: no emission, the path ends
+      end = FlightEnd::Absorbed;
+      return false;
+    }
+    if (xi < ma + ms) {
+      // One lane: exactly 1 (analog tracking) unless a fluorescent event adds d·Φ to the sum c.
+      if (kLanes != 1 || mf > 0.0f) w *= ss * (c / (mu * ms));
+      v.pos = tc.p;
+      v.material = m;
+      v.isotropic = false;
+      end = FlightEnd::Scattered;
+      return false;
+    }
+    if (mf > 0.0f && xi < ma + ms + mf) {
+      fluoresce(m, d, c / (mu * mf), rng, s);
+      v.env = s.out.fl_environment.data();
+      v.em = s.out.fl_emission.data();
+      v.dir_out = s.out.fl_directional.data();
+      v.pos = tc.p;
+      v.material = m;
+      v.isotropic = true;
+      end = FlightEnd::Scattered;
+      return false;
+    }
+    if (kLanes != 1 || mf > 0.0f) w *= sn * (c / (mu * mn));
+    return true;
+  });
+  return end;
+}
+
+template <int kLanes>
+void PathTracer::estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng,
+                                 PathScratch& s) const {
+  // Next-event estimation of every light with its own layer (LightSampler: a direction toward the
+  // light and its radiance / density), transmittance by ratio tracking up to the light (the box's
+  // exit for distant lights). Environment maps weight the sample by the power heuristic against
+  // the density q(ω) the phase sampling draws ω with (q = Σ_j w_j p_j / Σ_j w_j when g varies
+  // across lanes); their escaping paths carry the complementary weight.
+  const int n = v.n;
+  const Lanes<kLanes>& w = v.w;
+  const Lanes<kLanes> f = lanes_of<kLanes>(s.work.phase, n);
+  const ConstLanes<kLanes> T = lanes_of<kLanes>(std::as_const(s.work.transmittance), n);
+  for (std::size_t l = 0; l < m_lights.size(); ++l) {
+    LightSample ls;
+    if (!m_lights[l].sample(v.pos, rng, ls)) continue;
+    const Eigen::Vector3d& wl = ls.direction;
+    const auto cos_theta = static_cast<float>(v.dir.dot(wl));
+    transmittance<kLanes>(v.pos, wl, rng, s, ls.distance);
+    const Lanes<kLanes> out = v.lanes(v.dir_out + l * static_cast<std::size_t>(n));
+    if (g_constant) {
+      const float p = hg_phase(cos_theta, g[0]);
+      double k = ls.value;
+      if (ls.pdf > 0.0) k *= power_heuristic(ls.pdf, p);
+      const auto kp = static_cast<float>(std::min(k, kFloatMax)) * p;  // 1/r² of a light at the vertex
+      out += w * kp * T;
+    } else {
+      f = lane_map([cos_theta](float gi) { return hg_phase(cos_theta, gi); }, g);
+      double k = ls.value;
+      if (ls.pdf > 0.0) {
+        const float total = w.sum(), mix = sum_over(w * f, n);
+        k *= total > 0.0f ? power_heuristic(ls.pdf, mix / total) : 0.0;
       }
-      if (tmax < kTransmittanceRrThreshold) {
-        if (rng.uniform() < kTransmittanceRrStop) {
-          for (int i = 0; i < n; ++i) T[i] = 0.0f;
-          return;
-        }
-        const float k = 1.0f / (1.0f - kTransmittanceRrStop);
-        for (int i = 0; i < n; ++i) T[i] *= k;
-      }
+      const auto kf = static_cast<float>(std::min(k, kFloatMax));
+      out += w * kf * f * T;
     }
   }
 }
 
 template <int kLanes>
+bool PathTracer::sample_phase(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng,
+                              PathScratch& s) const {
+  // New direction from the phase function. With g varying across lanes: one-sample MIS over the
+  // lanes' lobes with the balance heuristic (Veach 1997, §9.2.4), the lobe chosen in proportion to
+  // the lanes' current weights, c_j = w_j / W with W = Σ_j w_j. The direction's density is then
+  // q(ω) = Σ_j c_j p_j(ω) and lane i is weighted by p_i(ω) / q(ω):
+  //   w_i' = w_i p_i / q = W · w_i p_i / Σ_j w_j p_j.
+  // Unbiased: c is fixed before ω is drawn and q > 0 wherever any p_i > 0 (HG lobes with |g| < 1
+  // cover the sphere), so E[w_i p_i(ω)/q(ω)] = w_i ∫ p_i = w_i (the phase function's normalisation).
+  // Bounded: the denominator holds the term w_i p_i, so w_i' ≤ W; and Σ_i w_i' = W exactly, so the
+  // sum of the lane weights never changes at a scattering and no lane exceeds it (≤ n · max_j w_j,
+  // the per-lane factor w_i'/w_i ≤ 1/c_i). With uniform c (the previous estimator, factor p_i /
+  // mean_j p_j ≤ n per scattering) the factors multiply along the path without bound.
+  // False when the path carries nothing any more.
+  const int n = v.n;
+  const Lanes<kLanes>& w = v.w;
+  float cos_theta;
+  if (g_constant) {
+    cos_theta = hg_sample_cos(g[0], rng.uniform());
+    if (m_any_mis) v.phase_pdf = hg_phase(cos_theta, g[0]);
+  } else {
+    const float total = w.sum();
+    if (!(total > 0.0f)) return false;
+    // Lane j with probability w_j / W (inverse CDF; lanes of weight 0 are never chosen).
+    const float target = rng.uniform() * total;
+    int j = 0;
+    float cdf = w[0];
+    while (j < n - 1 && cdf <= target) cdf += w[++j];
+    while (j > 0 && w[j] <= 0.0f) --j;  // float rounding past the end: the last lane that can be chosen
+    cos_theta = hg_sample_cos(g[j], rng.uniform());
+    const Lanes<kLanes> f = lanes_of<kLanes>(s.work.phase, n);
+    f = lane_map([cos_theta](float gi) { return hg_phase(cos_theta, gi); }, g);
+    const float mix = sum_over(w * f, n);  // Σ_j w_j p_j = W · q(ω)
+    if (!(mix > 0.0f)) return false;
+    v.phase_pdf = mix / total;
+    w *= f * (total / mix);
+  }
+  v.dir = direction_around(v.dir, cos_theta, rng.uniform_double()).normalized();
+  return true;
+}
+
+template <int kLanes>
+bool PathTracer::roulette(PathState<kLanes>& v, Rng& rng) const {
+  // Russian roulette on the largest lane weight (unbiased: survivors divided by the probability).
+  const float wmax = v.w.max();
+  if (!(wmax > 0.0f)) return false;
+  if (wmax < 1.0f) {
+    if (rng.uniform() >= wmax) return false;
+    v.w *= 1.0f / wmax;
+  }
+  return true;
+}
+
+template <int kLanes>
 void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) const {
   const int n = lane_count<kLanes>(s);
-  ++s.path_id;
-  if (s.path_id == 0) {  // wrapped: forget every stamp
-    std::fill(s.material_stamp.begin(), s.material_stamp.end(), 0u);
-    s.path_id = 1;
+  MaterialCache& cache = s.cache;
+  std::copy(s.in.lambda_nm.begin(), s.in.lambda_nm.end(), cache.lambda_nm.begin());
+  ++cache.path_id;
+  if (cache.path_id == 0) {  // wrapped: forget every stamp
+    std::fill(cache.stamp.begin(), cache.stamp.end(), 0u);
+    cache.path_id = 1;
   }
-  float* __restrict w = s.weight.data();
-  float* env = s.environment.data();  // not restrict: re-pointed at a fluorescent event
-  float* __restrict sa = s.sigma_a.data();
-  float* __restrict ss = s.sigma_s.data();
-  float* __restrict sn = s.sigma_n.data();
-  float* __restrict f = s.phase.data();
-  float* em = s.emission.data();
-  for (int i = 0; i < n; ++i) {
-    w[i] = 1.0f;
-    env[i] = 0.0f;
-    em[i] = 0.0f;
-  }
-  std::fill(s.directional.begin(), s.directional.end(), 0.0f);
-  // Where light seen from here on goes: the diagonal results, or after a fluorescent event the
-  // in side of the rank-one term (fl_*).
-  float* dir_out = s.directional.data();
-  s.fl_active = false;
-  bool isotropic = false;  // the last event was a fluorescent re-emission (phase 1/4π)
+  PathResult& out = s.out;
+  PathState<kLanes> v{n, lanes_of<kLanes>(s.work.weight, n), out.environment.data(), out.emission.data(),
+                      out.directional.data(), camera_ray.origin, camera_ray.direction};
+  v.w = 1.0f;
+  v.lanes(v.env) = 0.0f;
+  v.lanes(v.em) = 0.0f;
+  std::fill(out.directional.begin(), out.directional.end(), 0.0f);
+  out.fl_active = false;
 
-  Eigen::Vector3d pos = camera_ray.origin;
-  Eigen::Vector3d dir = camera_ray.direction;
-  double t_enter, t_exit;
-  if (!intersect_box(camera_ray, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) {
-    for (int i = 0; i < n; ++i) env[i] = 1.0f;
-    add_escape(dir, 0.0, w, dir_out, s);
+  if (!intersect_box(camera_ray, m_medium->bounds_min, m_medium->bounds_max, v.t_enter, v.t_exit)) {
+    v.lanes(v.env) = 1.0f;
+    add_escape(v.dir, 0.0, v.w.data(), v.dir_out, s);
     return;
   }
-  double phase_pdf = 0.0;  // density of dir's last draw from the phase function (0: camera ray)
   ++s.counters.paths_in_volume;
   int bounces = 0;
-  const std::int64_t step_limit = s.counters.collisions + s.counters.shadow_steps + kMaxPathSteps;
-  auto abandon = [&] {
-    for (int i = 0; i < n; ++i) env[i] = kAbandoned;
-  };
+  v.step_limit = s.counters.collisions + s.counters.shadow_steps + kMaxPathSteps;
   for (;;) {
-    // Free flight: delta tracking with spectral tracking's event probabilities (Kutz et al. 2017,
-    // "max" history-aware scheme): P_e ∝ max_i |w_i σ_e,i| for e ∈ {absorb, scatter, null}, and
-    // each lane's weight multiplied by σ_e,i / (μ̄ P_e). With one lane this is analog delta tracking.
-    const Ray ray{pos, dir};
-    MajorantTraversal walk(m_grid, ray, t_enter, t_exit);
-    MajorantTraversal::Segment seg;
-    bool scattered = false;
-    int material = 0;
-    while (!scattered && walk.next(seg)) {
-      ++s.counters.majorant_cells;
-      if (seg.majorant <= 0.0f) continue;
-      const float mu = seg.majorant;
-      const float inv_mu = 1.0f / mu;
-      double t = seg.t0;
-      for (;;) {
-        t -= std::log(rng.uniform()) * inv_mu;
-        if (t >= seg.t1) break;
-        if (++s.counters.collisions + s.counters.shadow_steps > step_limit) return abandon();
-        const Eigen::Vector3d p = pos + t * dir;
-        std::uint16_t m;
-        float d;
-        lookup(p, m, d);
-        if (m == Medium::kEmpty || d <= 0.0f) continue;  // σt = 0: a null collision of weight 1
-        if (s.material_stamp[m] != s.path_id) evaluate_material(m, s);
-        const float* __restrict st = s.sigma_t.data() + static_cast<std::size_t>(m) * n;
-        const float* __restrict al = s.albedo.data() + static_cast<std::size_t>(m) * n;
-        float ma = 0.0f, ms = 0.0f, mn = 0.0f, mf = 0.0f;
-        for (int i = 0; i < n; ++i) {
-          const float sig_t = d * st[i];
-          ss[i] = sig_t * al[i];
-          sa[i] = sig_t - ss[i];
-          sn[i] = std::max(0.0f, mu - sig_t);
-          ma = std::max(ma, w[i] * sa[i]);
-          ms = std::max(ms, w[i] * ss[i]);
-          mn = std::max(mn, w[i] * sn[i]);
-        }
-        const float* __restrict fo = nullptr;
-        if (m_fluorescent[m]) {
-          // The fluorescent source is a fourth event, of "coefficient" d·Φ_i (evaluate_fluorescence);
-          // σf itself is in σa (absorbed at the lane's own wavelength).
-          fo = s.fl_out.data() + static_cast<std::size_t>(m) * n;
-          for (int i = 0; i < n; ++i) mf = std::max(mf, w[i] * d * fo[i]);
-        }
-        if (m_emits[m]) {
-          // Emission, pbrt-v4's estimator: at every tentative collision, before the event is chosen,
-          // w_i σa,i Le,i / μ̄ (collisions come at rate μ̄, so the sum estimates ∫ T σa Le ds; the
-          // absorption event then contributes nothing and the null and scattering events keep their
-          // weights, which stays unbiased whatever the event probabilities).
-          const float* __restrict le = s.emission_le.data() + static_cast<std::size_t>(m) * n;
-          for (int i = 0; i < n; ++i) em[i] += w[i] * sa[i] * le[i] * inv_mu;
-        }
-        const float c = ma + ms + mf + mn;  // mf = 0 without fluorescence: the sum as before
-        if (!(c > 0.0f)) return;
-        const float xi = rng.uniform() * c;
-        if (xi < ma) return;  // absorbed: no emission, the path ends
-        if (xi < ma + ms) {
-          if (kLanes != 1 || mf > 0.0f) {  // one lane: exactly 1 (analog tracking) unless a fluorescent
-                                           // event adds d·Φ to the sum c
-            const float k = c / (mu * ms);
-            for (int i = 0; i < n; ++i) w[i] *= ss[i] * k;
-          }
-          pos = p;
-          material = m;
-          scattered = true;
-          isotropic = false;
-          break;
-        }
-        if (mf > 0.0f && xi < ma + ms + mf) {
-          fluoresce(m, d, c / (mu * mf), rng, s);
-          if (env != s.fl_environment.data()) {
-            env = s.fl_environment.data();
-            em = s.fl_emission.data();
-            dir_out = s.fl_directional.data();
-          }
-          pos = p;
-          material = m;
-          scattered = true;
-          isotropic = true;
-          break;
-        }
-        if (kLanes != 1 || mf > 0.0f) {
-          const float k = c / (mu * mn);
-          for (int i = 0; i < n; ++i) w[i] *= sn[i] * k;
-        }
-      }
-    }
-    if (!scattered) {
-      // Escaped: the unit environment (and the environment maps) seen with the path's weight.
-      for (int i = 0; i < n; ++i) env[i] += w[i];
-      add_escape(dir, phase_pdf, w, dir_out, s);
-      return;
+    switch (free_flight(v, rng, s)) {
+      case FlightEnd::Abandoned:
+        v.lanes(v.env) = kAbandoned;
+        return;
+      case FlightEnd::Absorbed:
+        return;
+      case FlightEnd::Escaped:  // the unit environment (and the environment maps) seen with the path's weight
+        v.lanes(v.env) += v.w;
+        add_escape(v.dir, v.phase_pdf, v.w.data(), v.dir_out, s);
+        return;
+      case FlightEnd::Scattered:
+        break;
     }
     if (m_max_bounces >= 0 && bounces >= m_max_bounces) return;
     ++bounces;
 
-    const float* __restrict g = isotropic ? s.zero_g.data() : s.g.data() + static_cast<std::size_t>(material) * n;
-    const bool g_constant = kLanes == 1 || isotropic || m_g_constant[material];
-
-    // Next-event estimation of every light with its own layer (LightSampler: a direction toward
-    // the light and its radiance / density), transmittance by ratio tracking up to the light (the
-    // box's exit for distant lights). Environment maps weight the sample by the power heuristic
-    // against the density q(ω) the phase sampling below draws ω with (q = Σ_j w_j p_j / Σ_j w_j
-    // when g varies across lanes); their escaping paths carry the complementary weight.
-    for (std::size_t l = 0; l < m_lights.size(); ++l) {
-      LightSample ls;
-      if (!m_lights[l].sample(pos, rng, ls)) continue;
-      const Eigen::Vector3d& wl = ls.direction;
-      const auto cos_theta = static_cast<float>(dir.dot(wl));
-      transmittance<kLanes>(pos, wl, rng, s, ls.distance);
-      const float* __restrict T = s.transmittance.data();
-      float* __restrict out = dir_out + l * static_cast<std::size_t>(n);
-      if (g_constant) {
-        const float p = hg_phase(cos_theta, g[0]);
-        double k = ls.value;
-        if (ls.pdf > 0.0) k *= power_heuristic(ls.pdf, p);
-        const auto kp = static_cast<float>(std::min(k, kFloatMax)) * p;  // 1/r² of a light at the vertex
-        for (int i = 0; i < n; ++i) out[i] += w[i] * kp * T[i];
-      } else {
-        for (int i = 0; i < n; ++i) f[i] = hg_phase(cos_theta, g[i]);
-        double k = ls.value;
-        if (ls.pdf > 0.0) {
-          float total = 0.0f, mix = 0.0f;
-          for (int i = 0; i < n; ++i) {
-            total += w[i];
-            mix += w[i] * f[i];
-          }
-          k *= total > 0.0f ? power_heuristic(ls.pdf, mix / total) : 0.0;
-        }
-        const auto kf = static_cast<float>(std::min(k, kFloatMax));
-        for (int i = 0; i < n; ++i) out[i] += w[i] * kf * f[i] * T[i];
-      }
-    }
-
-    // New direction from the phase function. With g varying across lanes: one-sample MIS over the
-    // lanes' lobes with the balance heuristic (Veach 1997, §9.2.4), the lobe chosen in proportion to
-    // the lanes' current weights, c_j = w_j / W with W = Σ_j w_j. The direction's density is then
-    // q(ω) = Σ_j c_j p_j(ω) and lane i is weighted by p_i(ω) / q(ω):
-    //   w_i' = w_i p_i / q = W · w_i p_i / Σ_j w_j p_j.
-    // Unbiased: c is fixed before ω is drawn and q > 0 wherever any p_i > 0 (HG lobes with |g| < 1
-    // cover the sphere), so E[w_i p_i(ω)/q(ω)] = w_i ∫ p_i = w_i (the phase function's normalisation).
-    // Bounded: the denominator holds the term w_i p_i, so w_i' ≤ W; and Σ_i w_i' = W exactly, so the
-    // sum of the lane weights never changes at a scattering and no lane exceeds it (≤ n · max_j w_j,
-    // the per-lane factor w_i'/w_i ≤ 1/c_i). With uniform c (the previous estimator, factor p_i /
-    // mean_j p_j ≤ n per scattering) the factors multiply along the path without bound.
-    float cos_theta;
-    if (g_constant) {
-      cos_theta = hg_sample_cos(g[0], rng.uniform());
-      if (m_any_mis) phase_pdf = hg_phase(cos_theta, g[0]);
-    } else {
-      float total = 0.0f;
-      for (int i = 0; i < n; ++i) total += w[i];
-      if (!(total > 0.0f)) return;
-      // Lane j with probability w_j / W (inverse CDF; lanes of weight 0 are never chosen).
-      const float target = rng.uniform() * total;
-      int j = 0;
-      float cdf = w[0];
-      while (j < n - 1 && cdf <= target) cdf += w[++j];
-      while (j > 0 && w[j] <= 0.0f) --j;  // float rounding past the end: the last lane that can be chosen
-      cos_theta = hg_sample_cos(g[j], rng.uniform());
-      float mix = 0.0f;  // Σ_j w_j p_j = W · q(ω)
-      for (int i = 0; i < n; ++i) {
-        f[i] = hg_phase(cos_theta, g[i]);
-        mix += w[i] * f[i];
-      }
-      if (!(mix > 0.0f)) return;
-      phase_pdf = mix / total;
-      const float k = total / mix;
-      for (int i = 0; i < n; ++i) w[i] *= f[i] * k;
-    }
-    dir = direction_around(dir, cos_theta, rng.uniform_double()).normalized();
-
-    // Russian roulette on the largest lane weight (unbiased: survivors divided by the probability).
-    float wmax = 0.0f;
-    for (int i = 0; i < n; ++i) wmax = std::max(wmax, w[i]);
-    if (!(wmax > 0.0f)) return;
-    if (wmax < 1.0f) {
-      if (rng.uniform() >= wmax) return;
-      const float k = 1.0f / wmax;
-      for (int i = 0; i < n; ++i) w[i] *= k;
-    }
-    const Ray next{pos, dir};
-    if (!intersect_box(next, m_medium->bounds_min, m_medium->bounds_max, t_enter, t_exit)) {
-      for (int i = 0; i < n; ++i) env[i] += w[i];
-      add_escape(dir, phase_pdf, w, dir_out, s);
+    const ConstLanes<kLanes> g = v.isotropic ? lanes_of<kLanes>(std::as_const(s.work.zero_g), n)
+                                             : lanes_of<kLanes>(std::as_const(cache.g), n, v.material);
+    const bool g_constant = kLanes == 1 || v.isotropic || m_g_constant[v.material];
+    estimate_lights(v, g, g_constant, rng, s);
+    if (!sample_phase(v, g, g_constant, rng, s)) return;
+    if (!roulette(v, rng)) return;
+    if (!intersect_box(Ray{v.pos, v.dir}, m_medium->bounds_min, m_medium->bounds_max, v.t_enter, v.t_exit)) {
+      v.lanes(v.env) += v.w;
+      add_escape(v.dir, v.phase_pdf, v.w.data(), v.dir_out, s);
       return;
     }
   }
@@ -586,62 +598,64 @@ void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch&
   // (a bias of 30 % in the tests). Φ was evaluated with Λ at the old wavelengths; the estimate of
   // ∫ σf·λ·L̄ dλ must use the new ones, hence the factor Λ'/Λ (the event's probability may use any Λ).
   const int n = s.lanes;
-  float* w = s.weight.data();
-  const float* fo = s.fl_out.data() + static_cast<std::size_t>(m) * n;
+  MaterialCache& cache = s.cache;
+  PathResult& out = s.out;
   if (n == 1) {
     // One wavelength per path (--wavelength-sampling single): the path's wavelength becomes λin,
     // drawn with density σf(λ)·λ/Λ (ExcitationSampler; Φ holds Λ), its weight that draw's. The out
     // side keeps the event's factor a = w·d·Φ·c/(μ̄·mf); the bin of λin is read off the wavelength.
-    const float event = w[0] * density * fo[0] * k;
+    float& w0 = s.work.weight[0];
+    const float event = w0 * density * cache.fl_out[static_cast<std::size_t>(m)] * k;
     const ExcitationSampler::Draw draw = m_fl_excitation[m].sample(rng.uniform_double());
-    s.lambda_nm[0] = static_cast<float>(draw.lambda_nm);
-    if (++s.path_id == 0) {  // every material is evaluated anew at the new wavelength
-      std::fill(s.material_stamp.begin(), s.material_stamp.end(), 0u);
-      s.path_id = 1;
+    cache.lambda_nm[0] = static_cast<float>(draw.lambda_nm);
+    if (++cache.path_id == 0) {  // every material is evaluated anew at the new wavelength
+      std::fill(cache.stamp.begin(), cache.stamp.end(), 0u);
+      cache.path_id = 1;
     }
-    if (!s.fl_active) {
-      s.fl_a[0] = event;
-      std::fill(s.fl_environment.begin(), s.fl_environment.end(), 0.0f);
-      std::fill(s.fl_emission.begin(), s.fl_emission.end(), 0.0f);
-      std::fill(s.fl_directional.begin(), s.fl_directional.end(), 0.0f);
-      s.fl_active = true;
-      w[0] = static_cast<float>(draw.weight);
+    if (!out.fl_active) {
+      out.fl_a[0] = event;
+      std::fill(out.fl_environment.begin(), out.fl_environment.end(), 0.0f);
+      std::fill(out.fl_emission.begin(), out.fl_emission.end(), 0.0f);
+      std::fill(out.fl_directional.begin(), out.fl_directional.end(), 0.0f);
+      out.fl_active = true;
+      w0 = static_cast<float>(draw.weight);
     } else {
-      w[0] = event * static_cast<float>(draw.weight);
+      w0 = event * static_cast<float>(draw.weight);
     }
     return;
   }
-  const double old_sum = s.fl_lambda_sum[m];
+  const Lanes<0> w = lanes_of<0>(s.work.weight, n);
+  const Lanes<0> a = lanes_of<0>(out.fl_a, n);
+  const ConstLanes<0> fo = lanes_of<0>(std::as_const(cache.fl_out), n, m);
+  const double old_sum = cache.fl_lambda_sum[m];
   float total = 0.0f;  // later events: Σ_i a'_i
-  if (!s.fl_active) {
-    for (int i = 0; i < n; ++i) s.fl_a[i] = w[i] * density * fo[i] * k;
-  } else {
-    for (int i = 0; i < n; ++i) total += w[i] * density * fo[i] * k;
-  }
+  if (!out.fl_active)
+    a = w * density * fo * k;
+  else
+    total = sum_over(w * density * fo * k, n);
   const double u = rng.uniform_double();
-  for (int i = 0; i < n; ++i) s.lambda_nm[i] = static_cast<float>(s.lo_nm[i] + u * s.width_nm[i]);
-  if (++s.path_id == 0) {  // every material is evaluated anew at the new wavelengths
-    std::fill(s.material_stamp.begin(), s.material_stamp.end(), 0u);
-    s.path_id = 1;
+  for (int i = 0; i < n; ++i) cache.lambda_nm[i] = static_cast<float>(s.in.lo_nm[i] + u * s.in.width_nm[i]);
+  if (++cache.path_id == 0) {  // every material is evaluated anew at the new wavelengths
+    std::fill(cache.stamp.begin(), cache.stamp.end(), 0u);
+    cache.path_id = 1;
   }
   evaluate_material(m, s);
-  const auto ratio = static_cast<float>(old_sum > 0.0 ? s.fl_lambda_sum[m] / old_sum : 0.0);
-  const float* fi = s.fl_in.data() + static_cast<std::size_t>(m) * n;
-  float pmax = 0.0f;
-  for (int j = 0; j < n; ++j) pmax = std::max(pmax, fi[j]);
-  if (!s.fl_active) {
+  const auto ratio = static_cast<float>(old_sum > 0.0 ? cache.fl_lambda_sum[m] / old_sum : 0.0);
+  const ConstLanes<0> fi = lanes_of<0>(std::as_const(cache.fl_in), n, m);
+  const float pmax = fi.max();
+  if (!out.fl_active) {
     // First event: the diagonal results so far stay; the in side starts empty. The lanes' largest
     // weight is made 1 (its scale moved to a) so that Russian roulette sees a unit path.
-    for (int i = 0; i < n; ++i) s.fl_a[i] *= ratio * pmax;
-    std::fill(s.fl_environment.begin(), s.fl_environment.end(), 0.0f);
-    std::fill(s.fl_emission.begin(), s.fl_emission.end(), 0.0f);
-    std::fill(s.fl_directional.begin(), s.fl_directional.end(), 0.0f);
-    s.fl_active = true;
+    a *= ratio * pmax;
+    std::fill(out.fl_environment.begin(), out.fl_environment.end(), 0.0f);
+    std::fill(out.fl_emission.begin(), out.fl_emission.end(), 0.0f);
+    std::fill(out.fl_directional.begin(), out.fl_directional.end(), 0.0f);
+    out.fl_active = true;
     const float inv = pmax > 0.0f ? 1.0f / pmax : 0.0f;
-    for (int j = 0; j < n; ++j) w[j] = fi[j] * inv;
+    w = fi * inv;
   } else {
     total *= ratio;
-    for (int j = 0; j < n; ++j) w[j] = total * fi[j];
+    w = total * fi;
   }
 }
 

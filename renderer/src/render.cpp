@@ -1,5 +1,5 @@
-// render(): passes of samples over the image, each pixel's samples accumulated in sample order in
-// double, so the result does not depend on threads or tiling.
+// render(): set-up, then passes of samples over the image into the Film (each pixel's samples
+// accumulated in sample order in double, so the result does not depend on threads or tiling).
 #include "prizma/render/render.h"
 
 #include <tbb/blocked_range.h>
@@ -14,10 +14,12 @@
 #include <optional>
 
 #include "prizma/render/camera.h"
+#include "prizma/render/film.h"
 #include "prizma/render/fluorescence.h"
 #include "prizma/render/path_tracer.h"
 #include "prizma/render/rng.h"
 #include "prizma/render/sample_range.h"
+#include "prizma/render/wavelength_map.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
 #include "prizma/spectral/tool_main.h"
@@ -27,21 +29,236 @@ namespace {
 
 using spectral::InputError;
 
-// Adaptive sampling looks at a pixel's error only after this many samples.
-constexpr std::int64_t kMinAdaptiveSamples = 16;
 // Automatic pass size: about this many paths per pass.
 constexpr std::int64_t kPathsPerPass = std::int64_t{1} << 20;
 
-enum class LaneMode { AllBins, Replicated, Single };
-
 struct ThreadState {
   PathScratch path;
-  std::vector<double> value;  // [light][bin] of one sample
+  std::vector<double> value;     // [light][bin] of one sample
   std::vector<double> value_fl;  // [light][bispectral pair] of one sample (fluorescent scenes)
   std::int64_t paths = 0;
   std::int64_t nan_or_inf = 0;
   std::int64_t converged = 0;
 };
+
+// Lights at unit white, as the file stores them (production): nothing folded in.
+struct UnitLights {
+  static constexpr bool kFolds = false;
+  double at(int, double) const { return 1.0; }
+};
+// settings.fold_light_spectra (tests and benchmarks): each light's contribution at λ multiplied by
+// its default spectrum at λ (the light "baked in", as VPT does). A separate instantiation of the
+// sample loop, so the production loop has no branch for it.
+struct FoldedLights {
+  static constexpr bool kFolds = true;
+  std::vector<spectral::Spectrum> spectra;  // per light
+  double at(int light, double lambda_nm) const { return spectra[light].eval(lambda_nm); }
+};
+
+// What every sample of one render shares.
+struct RenderContext {
+  const RenderSettings& settings;
+  const CameraModel& camera;
+  const PathTracer& tracer;
+  const WavelengthMap& map;
+  const FluorescenceLayout& fluor;
+  // Where each light's per-lane radiance comes from: the environment (−1), the medium's emission
+  // (−2) or a directional light (its index in the tracer's directional results).
+  std::vector<int> source;
+  bool fluorescent = false;  // fluor.any in all-bins or single mode: paths may fluoresce
+  // Single mode: pair_index[out·nb + in] is the bispectral pair of (out, in), −1 if none.
+  std::vector<int> pair_index;
+  Film& film;
+  const std::atomic<bool>* cancel = nullptr;
+  std::atomic<bool>& pass_cut;
+};
+
+// The samples of one pixel, for one way of treating the lights' spectra (Fold).
+template <class Fold>
+class PixelRenderer {
+ public:
+  PixelRenderer(const RenderContext& c, const Fold& fold) : m_c(c), m_fold(fold) {}
+
+  void render(ThreadState& ts, int x, int y, std::int64_t s0, std::int64_t s1) const {
+    const RenderSettings& st = m_c.settings;
+    const int width = m_c.camera.width();
+    const int nl = static_cast<int>(m_c.source.size());
+    const int nb = st.bins.size();
+    const std::size_t pix = static_cast<std::size_t>(y) * width + x;
+    if (m_c.film.converged(pix)) return;
+    PathScratch& ps = ts.path;
+    double* v = ts.value.data();
+    const std::size_t per_pixel = ts.value.size();
+    for (std::int64_t s = s0; s < s1; ++s) {
+      if (cancelled()) return;
+      Rng rng(st.seed, pix, static_cast<std::uint64_t>(s));
+      const double px = x + rng.uniform_double();
+      const double py = y + rng.uniform_double();
+      const Ray ray = m_c.camera.generate(px, py);
+      const WavelengthDraw draw = m_c.map.draw(rng, ps.in.lambda_nm.data());
+      m_c.tracer.trace(ray, rng, ps);
+      ++ts.paths;
+
+      // Lanes → (light, bin) values of this sample.
+      bool finite = true;
+      for (int l = 0; l < nl; ++l) {
+        double* out = v + static_cast<std::size_t>(l) * nb;
+        m_c.map.to_bins(lane_values(ps.out, l, false), draw, out);
+        if constexpr (Fold::kFolds) {
+          if (m_c.map.mode() == LaneMode::Single) {
+            out[draw.bin] *= m_fold.at(l, m_c.map.lambda_at(draw, draw.bin));
+          } else {
+            for (int i = 0; i < nb; ++i) out[i] *= m_fold.at(l, m_c.map.lambda_at(draw, i));
+          }
+        }
+        for (int i = 0; i < nb; ++i) finite = finite && std::isfinite(out[i]);
+      }
+      if (m_c.fluorescent) finite = add_fluorescent_sample(ps, draw.bin, v, ts.value_fl.data()) && finite;
+      if (!finite) {
+        // Never let a NaN/Inf reach the image: count it, take the sample as 0.
+        ++ts.nan_or_inf;
+        std::fill(v, v + per_pixel, 0.0);
+        std::fill(ts.value_fl.begin(), ts.value_fl.end(), 0.0);
+      }
+      if (m_c.film.add_sample(pix, v, ts.value_fl.data())) {
+        ++ts.converged;
+        return;
+      }
+    }
+  }
+
+ private:
+  // Cancellation is polled at every sample: a pass cut short is abandoned (the film goes back to
+  // its state before it), so the image still holds whole passes only.
+  bool cancelled() const {
+    if (m_c.cancel == nullptr || !m_c.cancel->load(std::memory_order_relaxed)) return false;
+    m_c.pass_cut.store(true, std::memory_order_relaxed);
+    return true;
+  }
+
+  // Light l's per-lane radiance in a path's result: the diagonal part, or (fl) the in side of the
+  // rank-one term of a path that fluoresced.
+  const float* lane_values(const PathResult& r, int l, bool fl) const {
+    const int src = m_c.source[l];
+    if (src == -2) return fl ? r.fl_emission.data() : r.emission.data();
+    if (src < 0) return fl ? r.fl_environment.data() : r.environment.data();
+    const auto row = static_cast<std::size_t>(src) * static_cast<std::size_t>(m_c.map.lanes());
+    return (fl ? r.fl_directional.data() : r.directional.data()) + row;
+  }
+
+  // A fluorescent path's rank-one term, M[out][in] = a[out]·(in side)[in] per light: off-diagonal
+  // pairs into vf, diagonal ones into the sample's transport v. Folded lights (test mode) weigh the
+  // in side by the light at λin and everything goes to the diagonal (the radiance at out).
+  // False when a value is not finite.
+  bool add_fluorescent_sample(const PathScratch& ps, int bin, double* v, double* vf) const {
+    const std::size_t per_pixel_fl = m_c.film.bispectral_per_pixel();
+    std::fill(vf, vf + per_pixel_fl, 0.0);
+    if (!ps.out.fl_active) return true;
+    const int nl = static_cast<int>(m_c.source.size());
+    const int nb = m_c.settings.bins.size();
+    const std::size_t np = m_c.fluor.pairs.size();
+    bool ok = true;
+    const float* a = ps.out.fl_a.data();
+    if (m_c.map.mode() == LaneMode::Single) {
+      // One lane: out = the camera bin (drawn with probability 1/n: weight n), in = the bin of the
+      // path's last wavelength (σf > 0 there, so the pair is in the layout).
+      const double lambda_in = ps.cache.lambda_nm[0];
+      const int in = m_c.settings.bins.find(lambda_in);
+      const int k = in < 0 ? -1 : in == bin ? -2 : m_c.pair_index[static_cast<std::size_t>(bin) * nb + in];
+      for (int l = 0; l < nl; ++l) {
+        const double val = static_cast<double>(a[0]) * lane_values(ps.out, l, true)[0] * nb * m_fold.at(l, lambda_in);
+        ok = ok && std::isfinite(val);
+        if (k == -2 || (k >= 0 && Fold::kFolds))
+          v[static_cast<std::size_t>(l) * nb + bin] += val;
+        else if (k >= 0)
+          vf[static_cast<std::size_t>(l) * np + static_cast<std::size_t>(k)] = val;
+      }
+      return ok;
+    }
+    for (int l = 0; l < nl; ++l) {
+      const float* src = lane_values(ps.out, l, true);
+      double* out = v + static_cast<std::size_t>(l) * nb;
+      // λin: the path's last wavelengths (a fluorescent event draws them anew; with two or more
+      // events chained the folded light is taken at the last segment's, an approximation of the
+      // test mode only).
+      auto fold_at = [&](int i) { return m_fold.at(l, ps.cache.lambda_nm[i]); };
+      for (std::size_t k = 0; k < np; ++k) {
+        const spectral::BinPair pr = m_c.fluor.pairs[k];
+        const double val = static_cast<double>(a[pr.out]) * src[pr.in] * fold_at(pr.in);
+        ok = ok && std::isfinite(val);
+        if constexpr (Fold::kFolds)
+          out[pr.out] += val;
+        else
+          vf[static_cast<std::size_t>(l) * np + k] = val;
+      }
+      for (int i : m_c.fluor.diagonal) {
+        out[i] += static_cast<double>(a[i]) * src[i] * fold_at(i);
+        ok = ok && std::isfinite(out[i]);
+      }
+    }
+    return ok;
+  }
+
+  const RenderContext& m_c;
+  const Fold& m_fold;
+};
+
+// Renders the passes [sample_begin, sample_end) into the film; returns the samples per pixel
+// completed (whole passes only) and sets interrupted when the cancel flag stopped it early.
+template <class Fold>
+std::int64_t run_passes(const RenderContext& c, const Fold& fold, tbb::enumerable_thread_specific<ThreadState>& states,
+                        const RenderCallbacks& callbacks, std::chrono::steady_clock::time_point start,
+                        bool& interrupted) {
+  const RenderSettings& st = c.settings;
+  const PixelRenderer<Fold> pixel(c, fold);
+  const int width = c.camera.width(), height = c.camera.height();
+  const std::int64_t total = st.sample_end - st.sample_begin;
+  std::int64_t per_pass = callbacks.samples_per_pass;
+  if (per_pass <= 0) per_pass = std::max<std::int64_t>(1, kPathsPerPass / static_cast<std::int64_t>(c.film.pixels()));
+  per_pass = std::min(per_pass, total);
+
+  std::optional<tbb::task_arena> arena;
+  if (st.threads > 0) arena.emplace(st.threads);
+  auto run_pass = [&](std::int64_t s0, std::int64_t s1) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+      ThreadState& ts = states.local();
+      for (int y = rows.begin(); y != rows.end() && !c.pass_cut.load(std::memory_order_relaxed); ++y)
+        for (int x = 0; x < width; ++x) pixel.render(ts, x, y, s0, s1);
+    });
+  };
+
+  std::int64_t done = 0;
+  interrupted = false;
+  while (done < total) {
+    if (callbacks.cancel && callbacks.cancel->load()) {
+      interrupted = true;
+      break;
+    }
+    const std::int64_t s0 = st.sample_begin + done;
+    const std::int64_t s1 = std::min(st.sample_end, s0 + per_pass);
+    if (callbacks.cancel) c.film.save();  // only a render that can be cancelled keeps a copy
+    if (arena)
+      arena->execute([&] { run_pass(s0, s1); });
+    else
+      run_pass(s0, s1);
+    if (c.pass_cut.load()) {
+      c.film.restore();
+      interrupted = true;
+      break;
+    }
+    done = s1 - st.sample_begin;
+    if (callbacks.progress) {
+      RenderProgress p;
+      p.samples_done = done;
+      p.samples_total = total;
+      for (const auto& t : states) p.paths += t.paths;
+      p.elapsed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      callbacks.progress(p);
+    }
+  }
+  if (done < total && !interrupted) interrupted = true;
+  return done;
+}
 
 }  // namespace
 
@@ -71,8 +288,6 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
 
   const CameraModel camera(scene.camera);
   const PathTracer tracer(scene, bins.min_nm(), bins.max_nm(), st.use_majorant_grid);
-  const int width = camera.width(), height = camera.height();
-  const std::size_t pixels = static_cast<std::size_t>(width) * height;
   const int nl = static_cast<int>(scene.lights.size());
 
   LaneMode mode = LaneMode::AllBins;
@@ -80,12 +295,13 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
     mode = LaneMode::Single;
   else if (tracer.wavelength_independent())
     mode = LaneMode::Replicated;
-  const int lanes = mode == LaneMode::AllBins ? nb : 1;
+  const WavelengthMap map(mode, bins);
   // Fluorescence (docs/fluorescence.md): the bispectral pairs the scene can fill; nothing of it
   // runs for a scene without fluorescence.
   const FluorescenceLayout fluor = fluorescence_layout(scene.medium, bins);
   // Single: the path's one wavelength changes at a fluorescent event (PathTracer::fluoresce); the
-  // pair (camera bin, bin of the last wavelength) gets the term. pair_index[out·nb + in]: its pair.
+  // pair (camera bin, bin of the last wavelength) gets the term.
+  const bool fluorescent = fluor.any && mode != LaneMode::Replicated;
   std::vector<int> pair_index;
   if (fluor.any && mode == LaneMode::Single) {
     pair_index.assign(static_cast<std::size_t>(nb) * nb, -1);
@@ -93,310 +309,57 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
       pair_index[static_cast<std::size_t>(fluor.pairs[k].out) * nb + fluor.pairs[k].in] = static_cast<int>(k);
   }
 
-  // Where each light's per-lane radiance comes from: the environment (−1), the medium's emission
-  // (−2) or a directional light.
   std::vector<int> source(nl, -1);
   for (std::size_t k = 0; k < tracer.directional_lights().size(); ++k)
     source[tracer.directional_lights()[k]] = static_cast<int>(k);
   if (tracer.emission_light() >= 0) source[tracer.emission_light()] = -2;
 
   // Test/benchmark mode: lights folded in with their default spectra.
-  std::vector<spectral::Spectrum> fold;
+  FoldedLights folded;
   if (st.fold_light_spectra) {
     spectral::SpecContext ctx;
     if (!scene.source.empty()) ctx.base_dir = scene.source.parent_path();
     for (int l = 0; l < nl; ++l) {
       ctx.input = "lights[" + std::to_string(l) + "].spectrum";
-      fold.push_back(spectral::parse_spectrum(scene.lights[l].spectrum_spec, ctx));
+      folded.spectra.push_back(spectral::parse_spectrum(scene.lights[l].spectrum_spec, ctx));
     }
   }
 
-  // Accumulators: per pixel, light and bin, in double.
-  const std::size_t per_pixel = static_cast<std::size_t>(nl) * nb;
-  const bool adaptive = st.target_error > 0.0;
-  const bool keep_squares = st.write_variance;
-  std::vector<double> sum(pixels * per_pixel, 0.0);
-  std::vector<double> sum_sq(keep_squares ? pixels * per_pixel : 0, 0.0);
-  std::vector<double> total_sum(adaptive ? pixels : 0, 0.0), total_sq(adaptive ? pixels : 0, 0.0);
-  std::vector<std::int64_t> count(pixels, 0);
-  std::vector<char> converged(pixels, 0);
-  const bool fluorescent = fluor.any && mode != LaneMode::Replicated;
-  const std::size_t np = fluor.pairs.size();
-  const std::size_t per_pixel_fl = fluorescent && st.fold_light_spectra ? 0 : static_cast<std::size_t>(nl) * np;
-  std::vector<double> sum_fl(fluorescent ? pixels * per_pixel_fl : 0, 0.0);
+  Film::Layout layout;
+  layout.width = camera.width();
+  layout.height = camera.height();
+  layout.lights = nl;
+  layout.bins = bins;
+  if (fluorescent && !st.fold_light_spectra) layout.bispectral = fluor.pairs;  // folded: all on the diagonal
+  layout.variance = st.write_variance;
+  layout.target_error = st.target_error;
+  Film film(std::move(layout));
 
   tbb::enumerable_thread_specific<ThreadState> states([&] {
     ThreadState t;
-    tracer.prepare(t.path, lanes);
-    t.value.assign(per_pixel, 0.0);
-    if (fluorescent) t.value_fl.assign(per_pixel_fl, 0.0);
+    tracer.prepare(t.path, map.lanes());
+    t.value.assign(film.values_per_pixel(), 0.0);
+    if (fluorescent) t.value_fl.assign(film.bispectral_per_pixel(), 0.0);
     if (fluorescent && mode == LaneMode::AllBins) {
       for (int i = 0; i < nb; ++i) {
-        t.path.lo_nm[i] = static_cast<float>(bins.lo_nm(i));
-        t.path.width_nm[i] = static_cast<float>(bins.width_nm(i));
+        t.path.in.lo_nm[i] = static_cast<float>(bins.lo_nm(i));
+        t.path.in.width_nm[i] = static_cast<float>(bins.width_nm(i));
       }
     }
     return t;
   });
 
-  const std::int64_t total = st.sample_end - st.sample_begin;
-  std::int64_t per_pass = callbacks.samples_per_pass;
-  if (per_pass <= 0) per_pass = std::max<std::int64_t>(1, kPathsPerPass / static_cast<std::int64_t>(pixels));
-  per_pass = std::min(per_pass, total);
-
-  // Cancellation is polled at every sample: a pass cut short is abandoned (the accumulators go
-  // back to their state before it), so the image still holds whole passes only.
   std::atomic<bool> pass_cut{false};
-  auto cancelled = [&] {
-    if (callbacks.cancel == nullptr || !callbacks.cancel->load(std::memory_order_relaxed)) return false;
-    pass_cut.store(true, std::memory_order_relaxed);
-    return true;
-  };
-  // A fluorescent path's rank-one term, M[out][in] = a[out]·(in side)[in] per light: off-diagonal
-  // pairs into vf, diagonal ones into the sample's transport (ts.value). Folded lights (test mode)
-  // weigh the in side by the light at λin and everything goes to the diagonal (the radiance at out).
-  // False when a value is not finite.
-  auto add_fluorescent_sample = [&](const PathScratch& ps, int bin, double* v, double* vf) -> bool {
-    std::fill(vf, vf + per_pixel_fl, 0.0);
-    if (!ps.fl_active) return true;
-    bool ok = true;
-    const float* a = ps.fl_a.data();
-    if (mode == LaneMode::Single) {
-      // One lane: out = the camera bin (drawn with probability 1/n: weight n), in = the bin of the
-      // path's last wavelength (σf > 0 there, so the pair is in the layout).
-      const int in = bins.find(ps.lambda_nm[0]);
-      const int k = in < 0 ? -1 : in == bin ? -2 : pair_index[static_cast<std::size_t>(bin) * nb + in];
-      for (int l = 0; l < nl; ++l) {
-        const float* src = source[l] == -2 ? ps.fl_emission.data()
-                           : source[l] < 0 ? ps.fl_environment.data()
-                                           : ps.fl_directional.data() + source[l];
-        const double val = static_cast<double>(a[0]) * src[0] * nb * (fold.empty() ? 1.0 : fold[l].eval(ps.lambda_nm[0]));
-        ok = ok && std::isfinite(val);
-        if (k == -2 || (k >= 0 && !fold.empty()))
-          v[static_cast<std::size_t>(l) * nb + bin] += val;
-        else if (k >= 0)
-          vf[static_cast<std::size_t>(l) * np + static_cast<std::size_t>(k)] = val;
-      }
-      return ok;
-    }
-    for (int l = 0; l < nl; ++l) {
-      const float* src = source[l] == -2 ? ps.fl_emission.data()
-                         : source[l] < 0 ? ps.fl_environment.data()
-                                         : ps.fl_directional.data() + static_cast<std::size_t>(source[l]) * lanes;
-      double* out = v + static_cast<std::size_t>(l) * nb;
-      // λin: the path's last wavelengths (a fluorescent event draws them anew; with two or more
-      // events chained the folded light is taken at the last segment's, an approximation of the
-      // test mode only).
-      auto fold_at = [&](int i) { return fold.empty() ? 1.0 : fold[l].eval(ps.lambda_nm[i]); };
-      for (std::size_t k = 0; k < np; ++k) {
-        const spectral::BinPair pr = fluor.pairs[k];
-        const double val = static_cast<double>(a[pr.out]) * src[pr.in] * fold_at(pr.in);
-        ok = ok && std::isfinite(val);
-        if (fold.empty())
-          vf[static_cast<std::size_t>(l) * np + k] = val;
-        else
-          out[pr.out] += val;
-      }
-      for (int i : fluor.diagonal) {
-        out[i] += static_cast<double>(a[i]) * src[i] * fold_at(i);
-        ok = ok && std::isfinite(out[i]);
-      }
-    }
-    return ok;
-  };
-  auto render_pixel = [&](ThreadState& ts, int x, int y, std::int64_t s0, std::int64_t s1) {
-    const std::size_t pix = static_cast<std::size_t>(y) * width + x;
-    if (converged[pix]) return;
-    double* acc = sum.data() + pix * per_pixel;
-    double* acc_sq = keep_squares ? sum_sq.data() + pix * per_pixel : nullptr;
-    PathScratch& ps = ts.path;
-    double* v = ts.value.data();
-    for (std::int64_t s = s0; s < s1; ++s) {
-      if (cancelled()) return;
-      Rng rng(st.seed, pix, static_cast<std::uint64_t>(s));
-      const double px = x + rng.uniform_double();
-      const double py = y + rng.uniform_double();
-      const Ray ray = camera.generate(px, py);
-      // Wavelengths: one jitter u shared by all bins, λ_i = lo_i + u·Δλ_i; Single picks one bin.
-      const double u = rng.uniform_double();
-      int bin = 0;
-      if (mode == LaneMode::Single) {
-        bin = std::min(nb - 1, static_cast<int>(rng.uniform_double() * nb));
-        ps.lambda_nm[0] = static_cast<float>(bins.lo_nm(bin) + u * bins.width_nm(bin));
-      } else if (mode == LaneMode::AllBins) {
-        for (int i = 0; i < nb; ++i) ps.lambda_nm[i] = static_cast<float>(bins.lo_nm(i) + u * bins.width_nm(i));
-      } else {
-        ps.lambda_nm[0] = static_cast<float>(bins.centre_nm(0));
-      }
-      tracer.trace(ray, rng, ps);
-      ++ts.paths;
-
-      // Lanes → (light, bin) values of this sample.
-      bool finite = true;
-      for (int l = 0; l < nl; ++l) {
-        const float* src = source[l] == -2 ? ps.emission.data()
-                           : source[l] < 0 ? ps.environment.data()
-                                           : ps.directional.data() + static_cast<std::size_t>(source[l]) * lanes;
-        double* out = v + static_cast<std::size_t>(l) * nb;
-        switch (mode) {
-          case LaneMode::AllBins:
-            for (int i = 0; i < nb; ++i) out[i] = src[i];
-            break;
-          case LaneMode::Replicated:
-            for (int i = 0; i < nb; ++i) out[i] = src[0];
-            break;
-          case LaneMode::Single:
-            for (int i = 0; i < nb; ++i) out[i] = 0.0;
-            out[bin] = static_cast<double>(src[0]) * nb;  // one bin of n drawn: weight n
-            break;
-        }
-        if (!fold.empty()) {
-          if (mode == LaneMode::Single) {
-            out[bin] *= fold[l].eval(bins.lo_nm(bin) + u * bins.width_nm(bin));
-          } else {
-            for (int i = 0; i < nb; ++i) out[i] *= fold[l].eval(bins.lo_nm(i) + u * bins.width_nm(i));
-          }
-        }
-        for (int i = 0; i < nb; ++i) finite = finite && std::isfinite(out[i]);
-      }
-      if (fluorescent) finite = add_fluorescent_sample(ps, bin, v, ts.value_fl.data()) && finite;
-      if (!finite) {
-        // Never let a NaN/Inf reach the image: count it, take the sample as 0.
-        ++ts.nan_or_inf;
-        std::fill(v, v + per_pixel, 0.0);
-        std::fill(ts.value_fl.begin(), ts.value_fl.end(), 0.0);
-      }
-      if (per_pixel_fl > 0) {
-        double* acc_fl = sum_fl.data() + pix * per_pixel_fl;
-        for (std::size_t k = 0; k < per_pixel_fl; ++k) acc_fl[k] += ts.value_fl[k];
-      }
-      double sample_total = 0.0;
-      for (std::size_t k = 0; k < per_pixel; ++k) {
-        acc[k] += v[k];
-        sample_total += v[k];
-      }
-      if (acc_sq)
-        for (std::size_t k = 0; k < per_pixel; ++k) acc_sq[k] += v[k] * v[k];
-      const std::int64_t nsamp = ++count[pix];
-      if (adaptive) {
-        total_sum[pix] += sample_total;
-        total_sq[pix] += sample_total * sample_total;
-        if (nsamp >= kMinAdaptiveSamples) {
-          const double n = static_cast<double>(nsamp);
-          const double mean = total_sum[pix] / n;
-          const double var = std::max(0.0, (total_sq[pix] / n - mean * mean) * n / (n - 1.0));
-          if (std::sqrt(var / n) <= st.target_error * std::abs(mean)) {
-            converged[pix] = 1;
-            ++ts.converged;
-            return;
-          }
-        }
-      }
-    }
-  };
-
-  std::optional<tbb::task_arena> arena;
-  if (st.threads > 0) arena.emplace(st.threads);
-  auto run_pass = [&](std::int64_t s0, std::int64_t s1) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
-      ThreadState& ts = states.local();
-      for (int y = rows.begin(); y != rows.end() && !pass_cut.load(std::memory_order_relaxed); ++y)
-        for (int x = 0; x < width; ++x) render_pixel(ts, x, y, s0, s1);
-    });
-  };
-
-  std::int64_t done = 0;
+  const RenderContext context{st,   camera, tracer, map, fluor, source, fluorescent, std::move(pair_index),
+                              film, callbacks.cancel, pass_cut};
   bool interrupted = false;
-  // The accumulators before the current pass, kept only when the render can be cancelled.
-  struct Snapshot {
-    std::vector<double> sum, sum_sq, total_sum, total_sq, sum_fl;
-    std::vector<std::int64_t> count;
-    std::vector<char> converged;
-  } before;
-  while (done < total) {
-    if (callbacks.cancel && callbacks.cancel->load()) {
-      interrupted = true;
-      break;
-    }
-    const std::int64_t s0 = st.sample_begin + done;
-    const std::int64_t s1 = std::min(st.sample_end, s0 + per_pass);
-    if (callbacks.cancel) {
-      before.sum.assign(sum.begin(), sum.end());
-      before.sum_fl.assign(sum_fl.begin(), sum_fl.end());
-      before.sum_sq.assign(sum_sq.begin(), sum_sq.end());
-      before.total_sum.assign(total_sum.begin(), total_sum.end());
-      before.total_sq.assign(total_sq.begin(), total_sq.end());
-      before.count.assign(count.begin(), count.end());
-      before.converged.assign(converged.begin(), converged.end());
-    }
-    if (arena)
-      arena->execute([&] { run_pass(s0, s1); });
-    else
-      run_pass(s0, s1);
-    if (pass_cut.load()) {
-      sum.swap(before.sum);
-      sum_fl.swap(before.sum_fl);
-      sum_sq.swap(before.sum_sq);
-      total_sum.swap(before.total_sum);
-      total_sq.swap(before.total_sq);
-      count.swap(before.count);
-      converged.swap(before.converged);
-      interrupted = true;
-      break;
-    }
-    done = s1 - st.sample_begin;
-    if (callbacks.progress) {
-      RenderProgress p;
-      p.samples_done = done;
-      p.samples_total = total;
-      for (const auto& t : states) p.paths += t.paths;
-      p.elapsed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      callbacks.progress(p);
-    }
-  }
-  if (done < total && !interrupted) interrupted = true;
+  const std::int64_t done = st.fold_light_spectra ? run_passes(context, folded, states, callbacks, start, interrupted)
+                                                  : run_passes(context, UnitLights{}, states, callbacks, start, interrupted);
   if (done == 0) throw spectral::RuntimeError("render interrupted before the first pass completed");
 
-  // The image: per-pixel means (and variances of the mean) as float.
-  spectral::SpectralImage img;
-  img.width = width;
-  img.height = height;
-  img.bins = bins;
-  img.lights.resize(nl);
-  for (int l = 0; l < nl; ++l) {
-    auto& layer = img.lights[l];
-    layer.name = scene.lights[l].name;
-    layer.data.assign(pixels * nb, 0.0f);
-    if (keep_squares) layer.variance.assign(pixels * nb, 0.0f);
-  }
-  for (std::size_t pix = 0; pix < pixels; ++pix) {
-    const double n = static_cast<double>(count[pix]);
-    for (int l = 0; l < nl; ++l) {
-      auto& layer = img.lights[l];
-      for (int i = 0; i < nb; ++i) {
-        const std::size_t k = pix * per_pixel + static_cast<std::size_t>(l) * nb + i;
-        const double mean = n > 0 ? sum[k] / n : 0.0;
-        layer.data[pix * nb + i] = static_cast<float>(mean);
-        if (keep_squares && n > 1) {
-          const double var = std::max(0.0, (sum_sq[k] / n - mean * mean) * n / (n - 1.0));
-          layer.variance[pix * nb + i] = static_cast<float>(var / n);
-        }
-      }
-    }
-  }
-  if (per_pixel_fl > 0) {
-    // The bispectral terms (docs/spectral-exr.md, "Bispectral channels"): per light, pairs contiguous.
-    img.reradiation = fluor.pairs;
-    for (int l = 0; l < nl; ++l) {
-      auto& r = img.lights[l].reradiation;
-      r.assign(pixels * np, 0.0f);
-      for (std::size_t pix = 0; pix < pixels; ++pix) {
-        const double n = static_cast<double>(count[pix]);
-        for (std::size_t k = 0; k < np; ++k)
-          r[pix * np + k] = n > 0 ? static_cast<float>(sum_fl[pix * per_pixel_fl + static_cast<std::size_t>(l) * np + k] / n) : 0.0f;
-      }
-    }
-  }
+  std::vector<std::string> names;
+  for (const Light& light : scene.lights) names.push_back(light.name);
+  spectral::SpectralImage img = film.image(names);
   img.info.is_prizma = true;
   img.info.lights_json = lights_to_json(scene.lights);
   img.info.samples = done;

@@ -19,6 +19,9 @@
 
 namespace prizma::render {
 
+template <int kN>
+class ConstLanes;  // renderer/src/lanes.h
+
 // Counters a path adds to (summed per thread, then over threads).
 struct PathCounters {
   std::int64_t paths_in_volume = 0;
@@ -27,40 +30,65 @@ struct PathCounters {
   std::int64_t majorant_cells = 0;
 };
 
-// Per-thread working memory, sized once for n lanes and the scene's materials.
-struct PathScratch {
-  int lanes = 0;
-  std::vector<float> lambda_nm;     // [lanes]
-  std::vector<float> sigma_t;       // [material][lanes] per unit density, at the path's wavelengths
-  std::vector<float> albedo;        // [material][lanes]
-  std::vector<float> g;             // [material][lanes]
-  std::vector<float> emission_le;   // [material][lanes] emitted radiance at density 1 (emitting materials)
-  std::vector<std::uint32_t> material_stamp;  // path id that last evaluated each material
+// Per-thread working memory of the tracer, sized once by PathTracer::prepare for n lanes and the
+// scene's materials, in four parts: what the caller sets (in), what the tracer caches per path
+// (cache), its temporaries (work) and what a path returns (out); plus counters.
+struct PathInputs {
+  std::vector<float> lambda_nm;  // [lanes] the path's wavelengths, set before every trace()
+  // Fluorescence (docs/fluorescence.md; used only when a material fluoresces): each lane's bin,
+  // set once. A fluorescent event draws the lanes' wavelengths anew, lo + u'·width; width 0 = the
+  // lane takes no part in fluorescence.
+  std::vector<float> lo_nm;     // [lanes]
+  std::vector<float> width_nm;  // [lanes]
+};
+
+// The materials' spectra at the path's current wavelengths, evaluated the first time the path
+// meets each material (stamped with the path id), so a collision costs a lookup and a few multiplies.
+struct MaterialCache {
+  std::vector<float> lambda_nm;    // [lanes] the wavelengths the cache holds: the inputs', then
+                                   // after a fluorescent event the last segment's
+  std::vector<float> sigma_t;      // [material][lanes] per unit density
+  std::vector<float> albedo;       // [material][lanes]
+  std::vector<float> g;            // [material][lanes]
+  std::vector<float> emission_le;  // [material][lanes] emitted radiance at density 1 (emitting materials)
+  std::vector<std::uint32_t> stamp;  // [material] path id that last evaluated it
   std::uint32_t path_id = 0;
-  std::vector<float> weight;        // [lanes] path throughput
-  std::vector<float> transmittance; // [lanes] ratio tracking
-  std::vector<float> phase;         // [lanes]
+  // Fluorescent materials (see PathTracer::evaluate_fluorescence).
+  std::vector<double> fl_lambda_sum;  // [material] Λ = Σ_j Δj·σf(λj)·λj
+  std::vector<float> fl_out;          // [material][lanes] Φ_i = q·ρ(λi)/λi·Λ per unit density
+  std::vector<float> fl_in;           // [material][lanes] p_j = Δj·σf(λj)·λj / Λ
+};
+
+// Temporaries of one path, meaningless between calls.
+struct PathWork {
+  std::vector<float> weight;         // [lanes] path throughput
+  std::vector<float> transmittance;  // [lanes] ratio tracking
+  std::vector<float> phase;          // [lanes]
   std::vector<float> sigma_a, sigma_s, sigma_n;  // [lanes] at the current collision
-  std::vector<float> environment;   // [lanes] result: radiance from the unit environment
-  std::vector<float> directional;   // [light with its own layer: directional_lights()][lanes] result
-  std::vector<float> emission;      // [lanes] result: radiance emitted by the medium (the emission light)
-  // Fluorescence (docs/fluorescence.md; sized only when a material fluoresces). The caller sets
-  // lo_nm and width_nm (each lane's bin; width 0 = the lane takes no part in fluorescence). A
-  // fluorescent event draws the lanes' wavelengths anew (lo + u'·width): lambda_nm then holds the
-  // last segment's wavelengths.
-  std::vector<float> lo_nm;         // [lanes]
-  std::vector<float> width_nm;      // [lanes]
-  std::vector<double> fl_lambda_sum;  // [material] Λ at the path's current wavelengths
-  std::vector<float> fl_out;        // [material][lanes] Φ_i = q·ρ(λi)/λi·Λ per unit density (see trace)
-  std::vector<float> fl_in;         // [material][lanes] p_j = Δj·σf(λj)·λj / Λ, Λ = Σ_j Δj·σf(λj)·λj
-  std::vector<float> zero_g;        // [lanes] g = 0: the isotropic re-emission
-  // Result of a path that fluoresced (fl_active): its transport is rank one, M[out][in] +=
-  // fl_a[out]·fl_<light>[in], on top of the diagonal results above (the part before the first event).
+  std::vector<float> zero_g;         // [lanes] g = 0: fluorescence's isotropic re-emission
+};
+
+// What trace() returns per lane (overwritten by every path): radiance at unit white.
+struct PathResult {
+  std::vector<float> environment;  // [lanes] from the unit environment
+  std::vector<float> directional;  // [light with its own layer: directional_lights()][lanes]
+  std::vector<float> emission;     // [lanes] emitted by the medium (the emission light)
+  // A path that fluoresced (fl_active): its transport is rank one, M[out][in] += fl_a[out]·fl_<light>[in],
+  // on top of the diagonal results above (the part before the first event). Sized only when a
+  // material fluoresces.
   bool fl_active = false;
   std::vector<float> fl_a;            // [lanes] out side
   std::vector<float> fl_environment;  // [lanes] in side, per light as the diagonal results
   std::vector<float> fl_directional;  // [directional light][lanes]
   std::vector<float> fl_emission;     // [lanes]
+};
+
+struct PathScratch {
+  int lanes = 0;
+  PathInputs in;
+  MaterialCache cache;
+  PathWork work;
+  PathResult out;
   PathCounters counters;
 };
 
@@ -72,12 +100,10 @@ class PathTracer {
 
   // Sizes scratch for `lanes` lanes.
   void prepare(PathScratch& scratch, int lanes) const;
-  // Traces the path of a camera ray at the wavelengths in scratch.lambda_nm (set by the caller).
-  // Results in scratch.environment and scratch.directional (overwritten).
+  // Traces the path of a camera ray at the wavelengths in scratch.in.lambda_nm (set by the caller).
+  // Results in scratch.out (overwritten).
   void trace(const Ray& ray, Rng& rng, PathScratch& scratch) const;
 
-  // True when the ray meets the medium's box (a miss sees only the environment).
-  bool hits_medium(const Ray& ray) const;
   // Lights with their own result in scratch.directional (directional, point, sphere, spot and
   // environment-map lights; not the uniform environment nor emission), in scene order: their
   // indices in scene.lights.
@@ -94,15 +120,31 @@ class PathTracer {
   bool any_fluorescence() const { return m_any_fluorescence; }
 
  private:
+  // How a free flight ends.
+  enum class FlightEnd { Scattered, Escaped, Absorbed, Abandoned };
+  template <int kLanes>
+  struct PathState;
+
+  // One path, the way pbrt-v4's volpath reads: free flight (→ absorbed / scattered / escaped),
+  // light estimates, phase sampling, roulette.
   template <int kLanes>
   void trace_lanes(const Ray& ray, Rng& rng, PathScratch& s) const;
+  template <int kLanes>
+  FlightEnd free_flight(PathState<kLanes>& v, Rng& rng, PathScratch& s) const;
+  template <int kLanes>
+  void estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng, PathScratch& s) const;
+  template <int kLanes>
+  bool sample_phase(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng, PathScratch& s) const;
+  template <int kLanes>
+  bool roulette(PathState<kLanes>& v, Rng& rng) const;
+  // Transmittance from origin along dir up to t_max, per lane, into s.work.transmittance.
   template <int kLanes>
   void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s,
                      double t_max = std::numeric_limits<double>::infinity()) const;
   // A path leaving the medium along dir: the environment maps' radiance, MIS-weighted against NEE
   // by the density phase_pdf its direction was drawn with (0 = a camera ray), times the weights,
-  // added to lights_out (the light layers: s.directional, or after a fluorescent event the in side
-  // of the re-radiation term, s.fl_directional).
+  // added to lights_out (the light layers: s.out.directional, or after a fluorescent event the in
+  // side of the re-radiation term, s.out.fl_directional).
   void add_escape(const Eigen::Vector3d& dir, double phase_pdf, const float* w, float* lights_out,
                   PathScratch& s) const;
   void evaluate_material(int m, PathScratch& s) const;
