@@ -1,19 +1,27 @@
 # install(): `cmake --install build --prefix X` gives a working tree, relocatable as a whole:
 #   X/bin/prizma-render, prizma-relight, prizma-metamer
+#   X/lib/prizma/libprizma_imageio.so, libprizma_vdb.so  the modules loaded on first use
 #   X/share/prizma/{spectra,ocio,scenes}   the data the tools read (found relative to the executable)
 #   X/share/doc/prizma/                    README.md and docs/ (the user guide runs against this tree)
 include(GNUInstallDirs)
 
 set(PRIZMA_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/prizma" CACHE STRING
     "Where the data tables, OCIO config and example scenes go, relative to the prefix")
-# The executables find the data from their own location, so the tree works wherever it is moved
-# ($PRIZMA_DATA_DIR still overrides): the path from bin/ to the data folder, compiled in.
+# The executables find the data and the modules from their own location, so the tree works wherever
+# it is moved ($PRIZMA_DATA_DIR still overrides): the path from bin/ up to the prefix and from the
+# prefix to the data folder, compiled in (libspectral installed_prefix.h, data_path.h).
 if(IS_ABSOLUTE "${CMAKE_INSTALL_BINDIR}" OR IS_ABSOLUTE "${PRIZMA_INSTALL_DATADIR}")
-  file(RELATIVE_PATH _prizma_data_rel "${CMAKE_INSTALL_FULL_BINDIR}" "${CMAKE_INSTALL_PREFIX}/${PRIZMA_INSTALL_DATADIR}")
+  file(RELATIVE_PATH _prizma_prefix_rel "${CMAKE_INSTALL_FULL_BINDIR}" "${CMAKE_INSTALL_PREFIX}")
+  file(RELATIVE_PATH _prizma_data_rel "${CMAKE_INSTALL_PREFIX}" "${CMAKE_INSTALL_PREFIX}/${PRIZMA_INSTALL_DATADIR}")
+  if(IS_ABSOLUTE "${PRIZMA_INSTALL_DATADIR}")
+    file(RELATIVE_PATH _prizma_data_rel "${CMAKE_INSTALL_PREFIX}" "${PRIZMA_INSTALL_DATADIR}")
+  endif()
 else()
-  file(RELATIVE_PATH _prizma_data_rel "/prefix/${CMAKE_INSTALL_BINDIR}" "/prefix/${PRIZMA_INSTALL_DATADIR}")
+  file(RELATIVE_PATH _prizma_prefix_rel "/prefix/${CMAKE_INSTALL_BINDIR}" "/prefix")
+  file(RELATIVE_PATH _prizma_data_rel "/prefix" "/prefix/${PRIZMA_INSTALL_DATADIR}")
 endif()
-target_compile_definitions(prizma_spectral PRIVATE PRIZMA_INSTALL_DATA_RELATIVE="${_prizma_data_rel}")
+target_compile_definitions(prizma_spectral PRIVATE PRIZMA_INSTALL_PREFIX_FROM_BINDIR="${_prizma_prefix_rel}"
+                                                   PRIZMA_INSTALL_DATA_FROM_PREFIX="${_prizma_data_rel}")
 
 set(_prizma_tools)
 foreach(tool prizma-render prizma-relight prizma-metamer)
@@ -26,9 +34,10 @@ install(TARGETS ${_prizma_tools} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COM
 # build this target. A new installed target (the Python module) adds itself with add_dependencies.
 add_custom_target(prizma-installed)
 add_dependencies(prizma-installed ${_prizma_tools})
-# The image module the tools load for PNG/TIFF/JPEG (imageio/; installed into lib/prizma) and the
-# Python module (python/; its own install rule): both are installed, so both are built.
-foreach(module prizma_imageio prizma_python)
+# The modules the tools load on first use — the image module for PNG/TIFF/JPEG (imageio/) and the
+# VDB module for OpenVDB volumes (vdb/), both installed into lib/prizma — and the Python module
+# (python/; its own install rule): all are installed, so all are built.
+foreach(module prizma_imageio prizma_vdb prizma_python)
   if(TARGET ${module})
     add_dependencies(prizma-installed ${module})
   endif()

@@ -1,11 +1,10 @@
 #include "prizma/spectral/data_path.h"
 
-#include <dlfcn.h>
-
 #include <cstdlib>
 #include <system_error>
 
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/installed_prefix.h"
 
 namespace prizma::spectral {
 
@@ -23,31 +22,17 @@ std::filesystem::path data_dir() {
   if (const char* env = std::getenv("PRIZMA_DATA_DIR"); env != nullptr && *env != '\0') {
     return std::filesystem::path(env);
   }
-  // 2. Installed layout, relative to the executable (<prefix>/bin/<exe> → <prefix>/share/prizma):
-  //    an installed tree works wherever it is moved, and does not depend on the source tree.
-  std::error_code ec;
-  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  // 2. Installed layout, relative to the tool or the Python module (installed_prefix.h:
+  //    <prefix>/bin/<exe> → <prefix>/share/prizma): an installed tree works wherever it is moved,
+  //    and does not depend on the source tree.
   std::filesystem::path installed;
-  if (!ec && !exe.empty()) {
-#ifdef PRIZMA_INSTALL_DATA_RELATIVE
-    installed = (exe.parent_path() / PRIZMA_INSTALL_DATA_RELATIVE).lexically_normal();
+  if (const std::filesystem::path prefix = installed_prefix(); !prefix.empty()) {
+#ifdef PRIZMA_INSTALL_DATA_FROM_PREFIX
+    installed = (prefix / PRIZMA_INSTALL_DATA_FROM_PREFIX).lexically_normal();
 #else
-    installed = exe.parent_path().parent_path() / "share" / "prizma";
+    installed = prefix / "share" / "prizma";
 #endif
     if (is_dir(installed)) return installed;
-  }
-  // 2b. This code inside a shared object that is not the executable: the Python module, installed
-  //     as <prefix>/lib/python3.X/site-packages/prizma/_prizma.so → <prefix>/share/prizma.
-  {
-    static const char anchor = 0;
-    Dl_info info{};
-    if (::dladdr(&anchor, &info) != 0 && info.dli_fname != nullptr && *info.dli_fname != '\0') {
-      const std::filesystem::path so = std::filesystem::absolute(std::filesystem::path(info.dli_fname), ec);
-      if (!ec && so != exe) {
-        const auto prefix = so.parent_path().parent_path().parent_path().parent_path().parent_path();
-        if (is_dir(prefix / "share" / "prizma")) return prefix / "share" / "prizma";
-      }
-    }
   }
   // 3. The source tree's data/ recorded at build time (running from the build tree).
 #ifdef PRIZMA_SOURCE_DATA_DIR

@@ -2,123 +2,35 @@
 #include "prizma/spectral/image_io.h"
 
 #include <dlfcn.h>
-#include <sys/resource.h>
-#include <unistd.h>
 
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <mutex>
-#include <system_error>
-#include <vector>
 
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/module_loader.h"
 
 namespace prizma::spectral {
 
 namespace {
 
-namespace fs = std::filesystem;
 namespace mod = image_io_module;
 
-constexpr const char* kModuleFile = "libprizma_imageio.so";
-
-fs::path executable_folder() {
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path() : exe.parent_path();
-}
-
-std::vector<fs::path> candidates() {
-  std::vector<fs::path> out;
-  if (const char* env = std::getenv("PRIZMA_IMAGE_IO_MODULE"); env != nullptr && *env != '\0') {
-    out.emplace_back(env);
-    return out;  // explicit: nothing else
-  }
-  const fs::path dir = executable_folder();
-  if (!dir.empty()) {
-    out.push_back(dir / kModuleFile);
-    out.push_back(dir.parent_path() / "lib" / "prizma" / kModuleFile);
-  }
-  // This code inside a shared object that is not the executable: the Python module, installed as
-  // <prefix>/lib/python3.X/site-packages/prizma/_prizma.so (or lib/python3/dist-packages), whose
-  // image module is <prefix>/lib/prizma/ three folders up.
-  static const char anchor = 0;
-  Dl_info info{};
-  if (::dladdr(&anchor, &info) != 0 && info.dli_fname != nullptr && *info.dli_fname != '\0') {
-    std::error_code ec;
-    const fs::path so = fs::absolute(fs::path(info.dli_fname), ec).parent_path();
-    if (!ec && so != dir) {
-      out.push_back(so / kModuleFile);
-      out.push_back(so.parent_path().parent_path().parent_path() / "prizma" / kModuleFile);
-    }
-  }
-#ifdef PRIZMA_IMAGE_IO_BUILD_PATH
-  out.emplace_back(PRIZMA_IMAGE_IO_BUILD_PATH);
-#endif
-  return out;
-}
-
-bool address_space_limited() {
-  rlimit lim{};
-  return ::getrlimit(RLIMIT_AS, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY;
-}
-
 const mod::Module* load_module() {
-  const std::vector<fs::path> paths = candidates();
-  fs::path chosen;
-  for (const fs::path& p : paths) {
-    std::error_code ec;
-    if (fs::exists(p, ec)) {
-      chosen = p;
-      break;
-    }
-  }
-  if (chosen.empty()) {
-    std::string looked;
-    for (const fs::path& p : paths) looked += (looked.empty() ? "" : ", ") + p.string();
-    throw RuntimeError("cannot find the image module " + std::string(kModuleFile) +
-                       " (needed for PNG, TIFF and transfer-function images; looked in: " + looked + ")");
-  }
+  ModuleSpec spec;
+  spec.file = "libprizma_imageio.so";
+  spec.env_var = "PRIZMA_IMAGE_IO_MODULE";
+  spec.name = "image module";
+  spec.needed_for = "needed for PNG, TIFF and transfer-function images";
+#ifdef PRIZMA_IMAGE_IO_BUILD_PATH
+  spec.build_path = PRIZMA_IMAGE_IO_BUILD_PATH;
+#endif
   // Near an address-space limit, OpenImageIO's dependencies fail inside their initialisers in
   // ways that cannot all be caught (log4cplus calls std::terminate; one limit, 485 MB, hung): the
   // ~450 MB its libraries map must be there before it is loaded.
-  if (address_space_limited()) {
-    rlimit lim{};
-    ::getrlimit(RLIMIT_AS, &lim);
-    long long used_kb = 0;
-    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
-      char line[256];
-      while (std::fgets(line, sizeof line, f) != nullptr)
-        if (std::sscanf(line, "VmSize: %lld kB", &used_kb) == 1) break;
-      std::fclose(f);
-    }
-    constexpr long long kNeededMb = 512;
-    const long long left_mb = static_cast<long long>(lim.rlim_cur / (1024 * 1024)) - used_kb / 1024;
-    if (left_mb < kNeededMb) {
-      throw RuntimeError("out of memory loading the image module " + chosen.string() + " (" +
-                         std::to_string(left_mb) + " MB of address space left under the limit; it maps about " +
-                         std::to_string(kNeededMb) + " MB)");
-    }
-  }
-  void* handle = nullptr;
-  {
-    // OpenImageIO's dependencies start threads and allocate in their initialisers: a crash or an
-    // exception there under a memory limit is reported as out of memory, as before main.
-    const LoadGuard guard("loading the image module " + chosen.string());
-    handle = ::dlopen(chosen.c_str(), RTLD_NOW | RTLD_LOCAL);
-  }
-  if (handle == nullptr) {
-    const char* e = ::dlerror();
-    const std::string why = e != nullptr ? e : "unknown error";
-    if (message_says_out_of_memory(why) ||
-        (address_space_limited() && why.find("failed to map segment") != std::string::npos)) {
-      throw RuntimeError("out of memory loading the image module " + chosen.string() + " (" + why + ")");
-    }
-    throw RuntimeError("cannot load the image module " + chosen.string() + ": " + why);
-  }
+  spec.address_space_needed_mb = 512;
+  std::filesystem::path chosen;
+  void* handle = open_module(spec, chosen);
   using Entry = const mod::Module* (*)();
   auto entry = reinterpret_cast<Entry>(::dlsym(handle, mod::kEntryPoint));
   const mod::Module* m = entry != nullptr ? entry() : nullptr;

@@ -541,7 +541,10 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   write_atomically(path, [&](AtomicOutput& out) {
     try {
       AtomicOStream stream(out);
-      Imf::OutputFile file(stream, header, io_threads());
+      // OpenEXR's thread count: 0 encodes in this thread, n ≥ 1 keeps n chunks in flight on its pool.
+      const int pool = io_threads();
+      const int in_flight = opts.threads == 1 ? 0 : opts.threads > 1 ? std::min(opts.threads, pool) : pool;
+      Imf::OutputFile file(stream, header, in_flight);
       file.setFrameBuffer(fb);
       file.writePixels(image.height);
     } catch (const InputError&) {

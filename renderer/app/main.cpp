@@ -131,9 +131,10 @@ class ProgressBar {
 
 void write_outputs(const spectral::SpectralImage& image, const std::filesystem::path& output, bool half,
                    const std::string& preview, const std::vector<render::Light>& lights,
-                   const std::filesystem::path& spectrum_base_dir) {
+                   const std::filesystem::path& spectrum_base_dir, int threads) {
   spectral::ExrWriteOptions wo;
   wo.pixel_type = half ? spectral::ExrPixelType::Half : spectral::ExrPixelType::Float;
+  wo.threads = threads;  // --threads holds for OpenEXR's encoding too
   spectral::write_spectral_exr(output, image, wo);
   if (!preview.empty()) {
     render::PreviewOptions po;
@@ -181,7 +182,7 @@ int merge_main(int argc, char** argv) {
       if (strict) throw InputError("merge", what);
       std::cerr << kProgram << ": warning: " << what << "\n";
     }
-    write_outputs(merged, output, half, preview, render::lights_from_image(merged), {});
+    write_outputs(merged, output, half, preview, render::lights_from_image(merged), {}, threads);
     if (!quiet)
       std::cerr << kProgram << ": merged " << shards.size() << (shards.size() == 1 ? " shard" : " shards")
                 << ", samples " << merged.info.sample_range << " → " << output << "\n";
@@ -252,6 +253,9 @@ int main(int argc, char** argv) {
       given.samples = render::SampleRange::parse(o.samples, "--samples");
     }
 
+    // --threads bounds the loading (classification, majorant grid) as well as the render.
+    std::optional<tbb::global_control> threads;
+    if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
     render::Scene scene;
     render::RenderOverrides recorded;  // what the output will record in prizma:renderOptions
     std::optional<spectral::SpectralImage> previous;
@@ -273,7 +277,7 @@ int main(int argc, char** argv) {
         check_outputs(o.output, "-o", o.preview);
         plan.previous.info.render_options = render::overrides_to_json(plan.overrides);
         write_outputs(plan.previous, o.output, plan.overrides.half, o.preview, plan.scene.lights,
-                      plan.scene.source.parent_path());
+                      plan.scene.source.parent_path(), o.threads);
         return spectral::kExitOk;
       }
       scene = std::move(plan.scene);
@@ -297,9 +301,6 @@ int main(int argc, char** argv) {
     if (output.empty()) output = o.resume.empty() ? scene.output : std::filesystem::path(o.resume);
     if (output.empty()) throw InputError("-o", "no output file: give -o or set \"output\" in the scene");
     check_outputs(output, !o.output.empty() ? "-o" : !o.resume.empty() ? "--resume" : o.scene + ": output", o.preview);
-
-    std::optional<tbb::global_control> threads;
-    if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
 
     if (o.verbose) {
       std::cerr << kProgram << ": scene " << scene.source.string() << " (hash " << scene.hash << "), "
@@ -342,7 +343,7 @@ int main(int argc, char** argv) {
     }
 
     write_outputs(image, output, half, o.preview, scene.lights,
-                  scene.source.empty() ? std::filesystem::path() : scene.source.parent_path());
+                  scene.source.empty() ? std::filesystem::path() : scene.source.parent_path(), o.threads);
 
     if (stats.nan_or_inf_count > 0)
       std::cerr << kProgram << ": warning: " << stats.nan_or_inf_count

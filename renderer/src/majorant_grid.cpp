@@ -1,5 +1,8 @@
 #include "prizma/render/majorant_grid.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,6 +13,17 @@ namespace prizma::render {
 
 namespace {
 float majorant_over_values(const Medium& medium, const std::vector<float>& sigma_t_max, float v_lo, float v_hi);
+
+// Runs body(cy, cz) for every row of cells (a y, z pair; the x cells of a row are the body's), rows
+// in parallel. Every cell's majorant is computed from the volume alone and written by the one task
+// that owns its row, so the grid is the same whatever the thread count.
+template <class Body>
+void for_each_cell_row(const std::array<int, 3>& cells, Body&& body) {
+  const int rows = cells[1] * cells[2];
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& r) {
+    for (int row = r.begin(); row != r.end(); ++row) body(row % cells[1], row / cells[1]);
+  });
+}
 }  // namespace
 
 MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma_t_max, int cell_voxels)
@@ -32,17 +46,19 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
   } else if (medium.interpolation == Interpolation::Trilinear) {
     build_trilinear(medium, sigma_t_max, span);
   } else {
-    for (int z = 0; z < d[2]; ++z)
-      for (int y = 0; y < d[1]; ++y)
-        for (int x = 0; x < d[0]; ++x) {
-          const std::size_t v = (static_cast<std::size_t>(z) * d[1] + y) * d[0] + x;
-          const std::uint16_t m = medium.material[v];
-          if (m == Medium::kEmpty) continue;
-          const float mu = medium.density[v] * sigma_t_max[m];
-          float& cell = m_majorant[(static_cast<std::size_t>(z / span[2]) * m_cells[1] + y / span[1]) * m_cells[0] +
-                                   x / span[0]];
-          cell = std::max(cell, mu);
-        }
+    for_each_cell_row(m_cells, [&](int cy, int cz) {
+      const int z1 = std::min(d[2], (cz + 1) * span[2]), y1 = std::min(d[1], (cy + 1) * span[1]);
+      float* row = m_majorant.data() + (static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0];
+      for (int z = cz * span[2]; z < z1; ++z)
+        for (int y = cy * span[1]; y < y1; ++y)
+          for (int x = 0; x < d[0]; ++x) {
+            const std::size_t v = (static_cast<std::size_t>(z) * d[1] + y) * d[0] + x;
+            const std::uint16_t m = medium.material[v];
+            if (m == Medium::kEmpty) continue;
+            float& cell = row[x / span[0]];
+            cell = std::max(cell, medium.density[v] * sigma_t_max[m]);
+          }
+    });
   }
   if (!medium.clip.empty()) zero_clipped_cells(medium);
   for (float mu : m_majorant) m_max = std::max(m_max, mu);
@@ -77,8 +93,7 @@ void MajorantGrid::build_from_blocks(const Medium& medium, const std::vector<flo
   constexpr int kB = Volume::kBlockVoxels;
   std::array<int, 3> nb{};
   for (int a = 0; a < 3; ++a) nb[a] = (medium.dims[a] + kB - 1) / kB;
-  for (int cz = 0; cz < m_cells[2]; ++cz)
-    for (int cy = 0; cy < m_cells[1]; ++cy)
+  for_each_cell_row(m_cells, [&](int cy, int cz) {
       for (int cx = 0; cx < m_cells[0]; ++cx) {
         const int c[3] = {cx, cy, cz};
         int lo[3], hi[3];
@@ -97,13 +112,13 @@ void MajorantGrid::build_from_blocks(const Medium& medium, const std::vector<flo
         m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] =
             majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
       }
+  });
 }
 
 void MajorantGrid::zero_clipped_cells(const Medium& medium) {
   // A cell whose every corner lies on the removed side of one clip plane holds no medium (the side
   // is a half-space, so the whole box does): its majorant 0 stays a bound and costs one DDA step.
-  for (int cz = 0; cz < m_cells[2]; ++cz)
-    for (int cy = 0; cy < m_cells[1]; ++cy)
+  for_each_cell_row(m_cells, [&](int cy, int cz) {
       for (int cx = 0; cx < m_cells[0]; ++cx) {
         const Eigen::Vector3d lo = m_min + Eigen::Vector3d(cx, cy, cz).cwiseProduct(m_cell_size);
         const Eigen::Vector3d hi = lo + m_cell_size;
@@ -117,6 +132,7 @@ void MajorantGrid::zero_clipped_cells(const Medium& medium) {
           }
         }
       }
+  });
 }
 
 void MajorantGrid::build_trilinear(const Medium& medium, const std::vector<float>& sigma_t_max,
@@ -128,8 +144,7 @@ void MajorantGrid::build_trilinear(const Medium& medium, const std::vector<float
   // them), so the bound is the largest σt over that whole value range: for every rule whose range
   // meets [v_lo, v_hi], its ramp's largest density there × the material's largest σt.
   const auto& d = medium.dims;
-  for (int cz = 0; cz < m_cells[2]; ++cz)
-    for (int cy = 0; cy < m_cells[1]; ++cy)
+  for_each_cell_row(m_cells, [&](int cy, int cz) {
       for (int cx = 0; cx < m_cells[0]; ++cx) {
         const int c[3] = {cx, cy, cz};
         int lo[3], hi[3];
@@ -150,6 +165,7 @@ void MajorantGrid::build_trilinear(const Medium& medium, const std::vector<float
         const float mu = majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
         m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] = mu;
       }
+  });
 }
 
 bool intersect_box(const Ray& ray, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double& t_enter,

@@ -220,10 +220,13 @@ std::int64_t run_passes(const RenderContext& c, const Fold& fold, tbb::enumerabl
   std::optional<tbb::task_arena> arena;
   if (st.threads > 0) arena.emplace(st.threads);
   auto run_pass = [&](std::int64_t s0, std::int64_t s1) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+    // Runs of pixels, not rows: a 24×24 image has 24 rows, each 1/24 of the pass, too few for two
+    // threads to finish a pass together; each pixel's samples are still taken by one task, in order.
+    const auto pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels, 4), [&](const tbb::blocked_range<std::size_t>& r) {
       ThreadState& ts = states.local();
-      for (int y = rows.begin(); y != rows.end() && !c.pass_cut.load(std::memory_order_relaxed); ++y)
-        for (int x = 0; x < width; ++x) pixel.render(ts, x, y, s0, s1);
+      for (std::size_t p = r.begin(); p != r.end() && !c.pass_cut.load(std::memory_order_relaxed); ++p)
+        pixel.render(ts, static_cast<int>(p % static_cast<std::size_t>(width)), static_cast<int>(p / static_cast<std::size_t>(width)), s0, s1);
     });
   };
 

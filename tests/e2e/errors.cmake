@@ -160,17 +160,17 @@ if(TARGET prizma-relight)
 endif()
 
 # Out of memory wherever it happens (issue 11): under a series of address-space limits each run is
-# a success or exit 1 with one "out of memory" line (below ~70 MB for prizma-render, which links
-# OpenVDB and its log4cplus for VDB volumes, and ~40 MB for prizma-relight, the dynamic loader itself
-# cannot map the libraries: exit 127 with ld.so's own message before any code runs, so the limits
-# start there). The PNG relight loads OpenImageIO's ~260 libraries with the image
+# a success or exit 1 with one "out of memory" line (below ~16 MB for prizma-render, ~40 MB for
+# prizma-relight, the dynamic loader itself cannot map the libraries: exit 127 with ld.so's own
+# message before any code runs, so the limits start there; OpenVDB comes with the VDB module, loaded
+# only for "vdb" volumes). The PNG relight loads OpenImageIO's ~260 libraries with the image
 # module when it writes (400–500 MB: log4cplus, loaded with it, gives up starting its thread).
 # Not in sanitizer builds: ASan reserves terabytes of address space.
 if(NOT PRIZMA_SANITIZE AND NOT PRIZMA_FUZZ AND TARGET prizma-render AND TARGET prizma-relight)
   set(_limits 400,420,440,450,460,480,500,550,600,800,1200,2000,4000)
   add_test(NAME errors.e2e.render_out_of_memory
            COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-memory-limits --workdir ${_errors_work}
-                   --output mem_render.exr --limits-mb 70,76,80,90,100,120,150,200,${_limits} -- $<TARGET_FILE:prizma-render> good.json -q -o mem_render.exr)
+                   --output mem_render.exr --limits-mb 16,20,24,28,32,40,50,64,100,${_limits} -- $<TARGET_FILE:prizma-render> good.json -q -o mem_render.exr)
   add_test(NAME errors.e2e.relight_out_of_memory
            COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-memory-limits --workdir ${_errors_work}
                    --output mem_relight.png --limits-mb 40,60,100,200,300,${_limits} -- $<TARGET_FILE:prizma-relight> good.exr -o mem_relight.png)

@@ -1,8 +1,13 @@
 // MajorantGrid and its DDA traversal; grid vs global majorant renders; empty space costs one step
 // per cell.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <vector>
 
 #include "prizma/render/majorant_grid.h"
 #include "prizma/render/render.h"
@@ -139,4 +144,94 @@ TEST(MajorantGrid, GridAndGlobalMajorantAgreeWithinNoise) {
 }
 
 }  // namespace
+}  // namespace prizma::render
+
+namespace prizma::render {
+
+// The grid is built in parallel over rows of cells (majorant_grid.cpp): every builder (nearest
+// voxels, trilinear value ranges, sparse block ranges, clip planes) gives the same cells bit for bit
+// on one thread and on four, and the nearest builder's cells are the maxima over their own voxels.
+namespace {
+
+Medium uneven_medium() {
+  Medium m;
+  m.dims = {41, 23, 34};  // not multiples of the cell size: short last cells on every axis
+  const std::size_t n = m.voxel_count();
+  m.material.assign(n, Medium::kEmpty);
+  m.density.assign(n, 0.0f);
+  m.value.assign(n, 0.0f);
+  m.materials = {testing::grey_material(0.5, 2.0), testing::grey_material(0.8, 7.0)};
+  std::uint32_t state = 7;
+  for (std::size_t v = 0; v < n; ++v) {
+    state = state * 1664525u + 1013904223u;
+    const float u = static_cast<float>(state >> 8) / 16777216.0f;
+    m.value[v] = 300.0f * u;
+    if (u < 0.3f) continue;  // empty
+    m.material[v] = u < 0.7f ? 0 : 1;
+    m.density[v] = u;
+  }
+  MaterialRule a, b;
+  a.value_lo = 90;
+  a.value_hi = 210;
+  a.material = 0;
+  b.value_lo = 210;
+  b.value_hi = 300;
+  b.material = 1;
+  m.rules = {a, b};
+  return m;
+}
+
+std::vector<float> cells_of(const MajorantGrid& g) {
+  std::vector<float> out;
+  for (int z = 0; z < g.cells()[2]; ++z)
+    for (int y = 0; y < g.cells()[1]; ++y)
+      for (int x = 0; x < g.cells()[0]; ++x) out.push_back(g.majorant(x, y, z));
+  return out;
+}
+
+std::vector<float> built_on(int threads, const Medium& m, int cell_voxels) {
+  tbb::task_arena arena(threads);
+  std::vector<float> out;
+  arena.execute([&] { out = cells_of(MajorantGrid(m, {2.0f, 7.0f}, cell_voxels)); });
+  return out;
+}
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+}  // namespace
+
+TEST(MajorantGrid, ParallelBuildIsTheSameOnAnyThreadCount) {
+  Medium m = uneven_medium();
+  m.clip = {ClipPlane{Eigen::Vector3d(0.6, 0.0, 0.8), 0.1}};
+  const std::vector<float> one = built_on(1, m, 8);
+  ASSERT_EQ(one.size(), std::size_t{6 * 3 * 5});
+  EXPECT_TRUE(same_bits(one, built_on(4, m, 8)));
+  EXPECT_TRUE(same_bits(built_on(1, m, 4), built_on(4, m, 4)));
+  EXPECT_TRUE(same_bits(built_on(1, m, 0), built_on(4, m, 0)));
+  m.interpolation = Interpolation::Trilinear;
+  EXPECT_TRUE(same_bits(built_on(1, m, 8), built_on(4, m, 8)));
+  m.block_range.assign(static_cast<std::size_t>(6) * 3 * 5, {100.0f, 250.0f});
+  m.block_range[17] = {0.0f, 50.0f};
+  EXPECT_TRUE(same_bits(built_on(1, m, 8), built_on(4, m, 8)));
+  EXPECT_TRUE(same_bits(built_on(1, m, 16), built_on(4, m, 16)));
+}
+
+TEST(MajorantGrid, ParallelNearestBuildHoldsEachCellsVoxelMaximum) {
+  const Medium m = uneven_medium();
+  const std::vector<float> sigma{2.0f, 7.0f};
+  const MajorantGrid grid(m, sigma, 8);
+  std::vector<float> want(static_cast<std::size_t>(6) * 3 * 5, 0.0f);
+  for (int z = 0; z < m.dims[2]; ++z)
+    for (int y = 0; y < m.dims[1]; ++y)
+      for (int x = 0; x < m.dims[0]; ++x) {
+        const std::size_t v = (static_cast<std::size_t>(z) * m.dims[1] + y) * m.dims[0] + x;
+        if (m.material[v] == Medium::kEmpty) continue;
+        float& c = want[(static_cast<std::size_t>(z / 8) * 3 + y / 8) * 6 + x / 8];
+        c = std::max(c, m.density[v] * sigma[m.material[v]]);
+      }
+  EXPECT_TRUE(same_bits(cells_of(grid), want));
+}
+
 }  // namespace prizma::render

@@ -4,13 +4,9 @@
 // shared libraries (OpenVDB, log4cplus, ffmpeg, …) that cost a tool ~0.25 s and ~100 MB before main;
 // a spectral render or relight that reads and writes only spectral EXRs (OpenEXR, linked) needs
 // none of them. The OpenImageIO code lives in the module libprizma_imageio.so, loaded (dlopen) the
-// first time one of the functions below is called. It is looked for, in order:
-//   $PRIZMA_IMAGE_IO_MODULE (a path: for tests and unusual installs)
-//   <folder of the executable>/libprizma_imageio.so
-//   <folder of the executable>/../lib/prizma/libprizma_imageio.so   (installed layout)
-//   when this code is in another shared object (the Python module …/prizma/_prizma.so): that
-//   folder, and <that folder>/../../../prizma/ (<prefix>/lib/prizma/ from lib/python3.X/site-packages/prizma/)
-//   the build tree's module (the path it was built at)
+// first time one of the functions below is called. It is looked for as every module is
+// (module_loader.h): $PRIZMA_IMAGE_IO_MODULE, next to the executable (or to the Python module's
+// _prizma.so), <prefix>/lib/prizma/ of the installed tree (installed_prefix.h), the build tree's path.
 // A module that cannot be loaded is a RuntimeError ("cannot load the image module <path>: <why>";
 // "out of memory loading the image module …" when the address space ran out), exit 1.
 #include <cstddef>

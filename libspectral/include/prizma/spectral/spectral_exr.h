@@ -71,6 +71,10 @@ struct ExrWriteOptions {
   // Preview channels R, G, B: the default relight (each light's recorded spectrum, CIE 1931) in linear
   // sRGB, for viewers that do not read spectra. Not covered by the checksum; readers ignore them.
   bool write_preview = true;
+  // Threads encoding the file's chunks: 0 = OpenEXR's global pool (the cores, at most 8); 1 = all in
+  // the calling thread (prizma-render --threads 1); n = at most n chunks in flight. The file is the
+  // same byte for byte whatever the count.
+  int threads = 0;
 };
 
 // Writes atomically (temporary file in the same folder, then rename): a failure never leaves a partial
