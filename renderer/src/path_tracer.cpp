@@ -42,6 +42,9 @@ double spectrum_max_over(const spectral::Spectrum& s, double lo_nm, double hi_nm
 
 PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi_nm, bool use_grid)
     : m_medium(&scene.medium), m_max_bounces(scene.settings.max_bounces) {
+  for (const MaterialEvents& e : choose_event_probabilities(scene.settings.event_probabilities, scene.medium.materials,
+                                                            scene.settings.bins))
+    m_events.push_back(e.scheme);
   const Medium& med = scene.medium;
   if (med.dims[0] < 1 || med.dims[1] < 1 || med.dims[2] < 1 || med.material.size() != med.voxel_count() ||
       med.density.size() != med.voxel_count())
@@ -384,8 +387,9 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   };
   for (;;) {
     // Free flight: delta tracking with spectral tracking's event probabilities (Kutz et al. 2017,
-    // "max" history-aware scheme): P_e ∝ max_i |w_i σ_e,i| for e ∈ {absorb, scatter, null}, and
-    // each lane's weight multiplied by σ_e,i / (μ̄ P_e). With one lane this is analog delta tracking.
+    // history-aware schemes, event_probability.h): P_e ∝ m_e = R_i(w_i σ_e,i) for e ∈ {absorb,
+    // scatter, null}, and each lane's weight multiplied by σ_e,i / (μ̄ P_e). With one lane this is
+    // analog delta tracking.
     const Ray ray{pos, dir};
     MajorantTraversal walk(m_grid, ray, t_enter, t_exit);
     MajorantTraversal::Segment seg;
@@ -415,16 +419,15 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
           ss[i] = sig_t * al[i];
           sa[i] = sig_t - ss[i];
           sn[i] = std::max(0.0f, mu - sig_t);
-          ma = std::max(ma, w[i] * sa[i]);
-          ms = std::max(ms, w[i] * ss[i]);
-          mn = std::max(mn, w[i] * sn[i]);
         }
+        const EventCoefficients ev = event_coefficients(m_events[m], n, w, sa, ss, sn);  // event_probability.h
+        ma = ev.absorb, ms = ev.scatter, mn = ev.null;
         const float* __restrict fo = nullptr;
         if (m_fluorescent[m]) {
           // The fluorescent source is a fourth event, of "coefficient" d·Φ_i (evaluate_fluorescence);
           // σf itself is in σa (absorbed at the lane's own wavelength).
           fo = s.fl_out.data() + static_cast<std::size_t>(m) * n;
-          for (int i = 0; i < n; ++i) mf = std::max(mf, w[i] * d * fo[i]);
+          mf = event_coefficient(m_events[m], n, w, d, fo);
         }
         if (m_emits[m]) {
           // Emission, pbrt-v4's estimator: at every tentative collision, before the event is chosen,
