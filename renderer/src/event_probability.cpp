@@ -46,14 +46,13 @@ MaterialEvents choose_event_probabilities(EventProbabilities requested, const Ma
   if (st_hi > 0.0) {  // else no extinction anywhere: no collisions to choose for
     c.extinction_ratio = st_lo > 0.0 ? st_hi / st_lo : std::numeric_limits<double>::infinity();
     c.albedo_spread = bins.size() > 0 ? al_hi - al_lo : 0.0;
+    c.albedo_max = bins.size() > 0 ? al_hi : 0.0;
   }
   if (requested != EventProbabilities::Auto) {
     c.scheme = requested;
     return c;
   }
-  const bool grey_extinction = c.extinction_ratio <= kGreyExtinctionRatio;
-  c.scheme = grey_extinction && c.albedo_spread > kSaturatedAlbedoSpread ? EventProbabilities::Max
-                                                                          : EventProbabilities::Average;
+  c.scheme = c.albedo_max < kAbsorbingAlbedo ? EventProbabilities::Average : EventProbabilities::Implicit;
   return c;
 }
 
@@ -72,7 +71,8 @@ std::string describe_event_probabilities(const std::vector<MaterialEvents>& choi
   o << std::setprecision(3);
   for (std::size_t k = 0; k < choice.size() && k < materials.size(); ++k)
     o << (k ? ", " : "") << materials[k].name << ' ' << event_probabilities_name(choice[k].scheme)
-      << " (extinction ratio " << choice[k].extinction_ratio << ", albedo spread " << choice[k].albedo_spread << ')';
+      << " (extinction ratio " << choice[k].extinction_ratio << ", albedo " << choice[k].albedo_max - choice[k].albedo_spread
+      << "–" << choice[k].albedo_max << ')';
   return o.str();
 }
 

@@ -131,23 +131,27 @@ TEST(EventProbability, CoefficientsOfEachScheme) {
 TEST(EventProbability, AutoRuleReadsTheSpectra) {
   const auto bins = spectral::BinLayout::linear(400, 700, 12);
   auto choose = [&](const Material& m) { return choose_event_probabilities(EventProbabilities::Auto, m, bins); };
-  // Grey: nothing to choose between; average (one lane anyway).
+  // Grey and scattering: implicit (one lane anyway when every material is grey).
   auto c = choose(grey_material(0.8, 5.0));
-  EXPECT_EQ(c.scheme, EventProbabilities::Average);
+  EXPECT_EQ(c.scheme, EventProbabilities::Implicit);
   EXPECT_DOUBLE_EQ(c.extinction_ratio, 1.0);
   EXPECT_DOUBLE_EQ(c.albedo_spread, 0.0);
-  // Chromatic extinction (the Rayleigh-like cube): average.
+  EXPECT_DOUBLE_EQ(c.albedo_max, 0.8);
+  // Chromatic extinction (the Rayleigh-like cube): implicit.
   c = choose(make_material(Spectrum::constant(0.99), Spectrum({400.0, 700.0}, {9.0, 1.0}), Spectrum::constant(0.0)));
-  EXPECT_EQ(c.scheme, EventProbabilities::Average);
+  EXPECT_EQ(c.scheme, EventProbabilities::Implicit);
   EXPECT_GT(c.extinction_ratio, 5.0);
-  // Grey extinction, saturated albedo (the metamer spheres): max.
+  // Saturated albedo (the metamer spheres): implicit.
   c = choose(make_material(Spectrum({400.0, 550.0, 700.0}, {0.05, 0.9, 0.1}), Spectrum::constant(40.0),
                            Spectrum::constant(0.0)));
-  EXPECT_EQ(c.scheme, EventProbabilities::Max);
-  EXPECT_GT(c.albedo_spread, kSaturatedAlbedoSpread);
-  // Grey extinction, mild albedo (the MRI's tissues): average.
-  c = choose(make_material(Spectrum({400.0, 700.0}, {0.5, 0.8}), Spectrum::constant(30.0), Spectrum::constant(0.2)));
+  EXPECT_EQ(c.scheme, EventProbabilities::Implicit);
+  EXPECT_GT(c.albedo_spread, 0.5);
+  // Absorbing more than scattering in every bin: average (absorption ends the path).
+  c = choose(make_material(Spectrum({400.0, 700.0}, {0.0, 0.4}), Spectrum({400.0, 700.0}, {3.0, 1.0}),
+                           Spectrum::constant(0.0)));
   EXPECT_EQ(c.scheme, EventProbabilities::Average);
+  EXPECT_LT(c.albedo_max, kAbsorbingAlbedo);
+  EXPECT_EQ(choose(grey_material(0.0, 2.0)).scheme, EventProbabilities::Average);
   // A forced scheme is kept, the measurements still made; one entry per material.
   const auto all = choose_event_probabilities(EventProbabilities::Mixed,
                                               {grey_material(0.5, 2.0), grey_material(0.5, 3.0)}, bins);
@@ -177,6 +181,7 @@ TEST(EventProbability, AutoRendersAsTheSchemeItChooses) {
   s.settings.event_probabilities = chosen;
   const auto b = render(s);
   s.settings.event_probabilities = chosen == EventProbabilities::Max ? EventProbabilities::Average : EventProbabilities::Max;
+  EXPECT_EQ(chosen, EventProbabilities::Implicit);
   const auto other = render(s);
   EXPECT_EQ(a.lights[0].data, b.lights[0].data);
   EXPECT_NE(a.lights[0].data, other.lights[0].data);  // the setting reaches the tracer
@@ -277,3 +282,4 @@ TEST(EventProbability, SaturatedHalfSpaceMatchesChandrasekharForEveryScheme) {
 
 }  // namespace
 }  // namespace prizma::render
+

@@ -37,14 +37,16 @@ struct MaterialEvents {
   EventProbabilities scheme = EventProbabilities::Max;
   double extinction_ratio = 1.0;  // max_i σt,i / min_i σt,i over the bins (1 = grey; ∞ when some σt,i = 0)
   double albedo_spread = 0.0;     // max_i α_i − min_i α_i over the bins (α = σs/σt)
+  double albedo_max = 0.0;        // max_i α_i
 };
 
 // The auto rule (docs/renderer.md, "Event probabilities"), per material, since the scheme may change
-// from one collision to the next without bias. Deterministic: a function of the material's spectra
-// and the bins only. `requested` other than Auto is given to every material as it is (the
+// from one collision to the next without bias: "implicit", except in a material that absorbs more
+// than it scatters in every bin (max_i α_i < kAbsorbingAlbedo), where implicit capture would walk
+// the path through the whole absorber: "average" there. Deterministic: a function of the material's
+// spectra and the bins only. `requested` other than Auto is given to every material as it is (the
 // measurements still made).
-inline constexpr double kGreyExtinctionRatio = 1.5;
-inline constexpr double kSaturatedAlbedoSpread = 0.5;
+inline constexpr double kAbsorbingAlbedo = 0.5;
 MaterialEvents choose_event_probabilities(EventProbabilities requested, const Material& material,
                                           const spectral::BinLayout& bins);
 std::vector<MaterialEvents> choose_event_probabilities(EventProbabilities requested,
