@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <iomanip>
 #include <numbers>
 #include <vector>
 
@@ -283,3 +284,23 @@ TEST(EventProbability, SaturatedHalfSpaceMatchesChandrasekharForEveryScheme) {
 }  // namespace
 }  // namespace prizma::render
 
+namespace prizma::render {
+namespace {
+
+TEST(EventProbability, PinnedValueOfTheAutoScheme) {
+  // One absolute value of the default (auto: implicit here) at a fixed seed, so that a change of the
+  // scheme's arithmetic or of its random numbers shows: the mean over pixels of bin 0 of the
+  // environment and sun layers of the determinism tests' chromatic box, 8 spp.
+  const auto img = render(testing::chromatic_scene(8));
+  const auto env = pixel_average(img, 0), sun = pixel_average(img, 1);
+  EXPECT_NEAR(env.mean[0], 0.80465904, 1e-6) << std::setprecision(9) << env.mean[0];
+  EXPECT_NEAR(sun.mean[0], 0.048613553, 1e-6) << std::setprecision(9) << sun.mean[0];
+  // And the closed-form scale it must sit in: within 3 standard errors of the max scheme's render.
+  Scene s = testing::chromatic_scene(8);
+  s.settings.event_probabilities = EventProbabilities::Max;
+  const auto mx = pixel_average(render(s), 0);
+  EXPECT_NEAR(env.mean[0], mx.mean[0], 3.0 * std::hypot(env.se[0], mx.se[0]));
+}
+
+}  // namespace
+}  // namespace prizma::render
