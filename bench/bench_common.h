@@ -149,7 +149,7 @@ inline spectral::SpectralImage cached_render(const render::Scene& scene, const f
   key << scene.hash << '|' << scene.camera.width << 'x' << scene.camera.height << '|' << st.bins.to_string() << '|'
       << st.sample_begin << ':' << st.sample_end << '|' << st.seed << '|'
       << render::wavelength_sampling_name(st.wavelength_sampling) << '|' << st.fold_light_spectra << '|'
-      << st.write_variance << '|' << st.max_bounces;
+      << st.write_variance << '|' << st.max_bounces << '|' << render::event_probabilities_name(st.event_probabilities);
   for (const auto& l : scene.lights) key << '|' << l.name << ':' << l.spectrum_spec;
   const fs::path file = cache_dir / (tag + "-" + hash_hex(key.str()) + ".exr");
   if (fs::exists(file)) {

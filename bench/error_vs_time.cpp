@@ -2,6 +2,7 @@
 // a function of render time, for each wavelength-sampling method with and without the majorant grid.
 // Writes one CSV row per (scene, method, sample count). Driven by bench/error-vs-time, which plots.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <iomanip>
@@ -22,10 +23,12 @@ struct Method {
   std::string name;
   pr::WavelengthSampling sampling;
   bool grid;
+  pr::EventProbabilities events = pr::EventProbabilities::Auto;
 };
 
 struct Options {
   std::vector<std::string> scenes{"grey", "cube", "metamers", "mri"};
+  std::vector<std::string> methods{"single", "single-nogrid", "spectral", "spectral-nogrid"};
   int size = 64;
   std::int64_t ref_spp = 8192;
   std::int64_t max_spp = 256;
@@ -42,6 +45,9 @@ int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Error versus time of each wavelength-sampling method against a high-sample reference"};
   app.add_option("--scenes", o.scenes, "grey, cube, metamers, mri");
+  app.add_option("--methods", o.methods,
+                 "single, single-nogrid, spectral (auto event probabilities), spectral-nogrid, spectral-max, "
+                 "spectral-average, spectral-mixed, spectral-implicit");
   app.add_option("--size", o.size, "image width and height in pixels");
   app.add_option("--ref-spp", o.ref_spp, "reference samples per pixel (spectral tracking, grid)");
   app.add_option("--max-spp", o.max_spp, "largest sample count of the measured renders (powers of 2 up to it)");
@@ -52,12 +58,25 @@ int main(int argc, char** argv) {
   app.add_flag("--references-only", o.references_only, "only render (and cache) the references");
   CLI11_PARSE(app, argc, argv);
 
-  const std::vector<Method> methods = {
+  const std::vector<Method> known = {
       {"single", pr::WavelengthSampling::Single, true},
       {"single-nogrid", pr::WavelengthSampling::Single, false},
       {"spectral", pr::WavelengthSampling::SpectralTracking, true},
       {"spectral-nogrid", pr::WavelengthSampling::SpectralTracking, false},
+      {"spectral-max", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Max},
+      {"spectral-average", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Average},
+      {"spectral-mixed", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Mixed},
+      {"spectral-implicit", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Implicit},
   };
+  std::vector<Method> methods;
+  for (const std::string& name : o.methods) {
+    const auto it = std::find_if(known.begin(), known.end(), [&](const Method& m) { return m.name == name; });
+    if (it == known.end()) {
+      std::cerr << "bench_error_vs_time: error: --methods: unknown method \"" << name << "\"\n";
+      return 2;
+    }
+    methods.push_back(*it);
+  }
 
   std::ostringstream csv;
   csv << "scene,method,spp,seconds,paths,collisions,shadow_steps,rel_rmse,rel_rmse_corrected,mean_de00,"
@@ -81,6 +100,7 @@ int main(int argc, char** argv) {
       pr::Scene ref_scene = scene;
       ref_scene.settings.wavelength_sampling = pr::WavelengthSampling::SpectralTracking;
       ref_scene.settings.use_majorant_grid = true;
+      ref_scene.settings.event_probabilities = pr::EventProbabilities::Max;  // fixed: the cache stays valid
       ref_scene.settings.sample_begin = 0;
       ref_scene.settings.sample_end = o.ref_spp;
       ref_scene.settings.seed = o.seed + 1000003;
@@ -102,15 +122,18 @@ int main(int argc, char** argv) {
       const auto ref_xyz = pb::relight_all(ref, "D65", &white);
       const std::vector<char> background = pb::background_mask(ref);
 
-      for (const Method& m : methods) {
-        pr::Scene s = scene;
-        s.settings.wavelength_sampling = m.sampling;
-        s.settings.use_majorant_grid = m.grid;
-        s.settings.seed = o.seed;
-        s.settings.write_variance = false;
-        // Each sample count is a fresh render of samples [0, n): its wall time includes the set-up
-        // (majorant grid, material tables) once, as a user's render would.
-        for (std::int64_t n = 1; n <= o.max_spp; n *= 2) {
+      // Sample counts outer, methods inner: the methods are interleaved, so a change of the machine's
+      // load during the run falls on all of them alike.
+      for (std::int64_t n = 1; n <= o.max_spp; n *= 2) {
+        for (const Method& m : methods) {
+          pr::Scene s = scene;
+          s.settings.wavelength_sampling = m.sampling;
+          s.settings.use_majorant_grid = m.grid;
+          s.settings.event_probabilities = m.events;
+          s.settings.seed = o.seed;
+          s.settings.write_variance = false;
+          // Each sample count is a fresh render of samples [0, n): its wall time includes the set-up
+          // (majorant grid, material tables) once, as a user's render would.
           s.settings.sample_begin = 0;
           s.settings.sample_end = n;
           pr::RenderStats st;

@@ -308,6 +308,12 @@ int main(int argc, char** argv) {
                 << st.bins.to_string() << ", samples " << st.sample_begin << ":" << st.sample_end << ", seed "
                 << st.seed << ", " << render::wavelength_sampling_name(st.wavelength_sampling)
                 << (st.use_majorant_grid ? ", majorant grid" : ", global majorant") << "\n";
+      std::cerr << kProgram << ": event probabilities ("
+                << render::event_probabilities_name(st.event_probabilities) << "): "
+                << render::describe_event_probabilities(
+                       render::choose_event_probabilities(st.event_probabilities, scene.medium.materials, st.bins),
+                       scene.medium.materials)
+                << "\n";
       if (!scene.volume_note.empty()) std::cerr << kProgram << ": " << scene.volume_note << "\n";
       for (const auto& l : scene.lights)
         std::cerr << kProgram << ": light " << l.name << ": " << render::describe_light(l) << ", default spectrum "

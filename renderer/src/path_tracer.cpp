@@ -55,6 +55,9 @@ double spectrum_max_over(const spectral::Spectrum& s, double lo_nm, double hi_nm
 
 PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi_nm, bool use_grid)
     : m_medium(&scene.medium), m_max_bounces(scene.settings.max_bounces) {
+  for (const MaterialEvents& e : choose_event_probabilities(scene.settings.event_probabilities, scene.medium.materials,
+                                                            scene.settings.bins))
+    m_events.push_back(e.scheme);
   const Medium& med = scene.medium;
   if (med.dims[0] < 1 || med.dims[1] < 1 || med.dims[2] < 1 || med.material.size() != med.voxel_count() ||
       med.density.size() != med.voxel_count())
@@ -362,9 +365,9 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
 
 template <int kLanes>
 PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, PathScratch& s) const {
-  // Delta tracking with spectral tracking's event probabilities (Kutz et al. 2017, "max"
-  // history-aware scheme): P_e ∝ max_i |w_i σ_e,i| for e ∈ {absorb, scatter, null}, and each
-  // lane's weight multiplied by σ_e,i / (μ̄ P_e). With one lane this is analog delta tracking.
+  // Delta tracking with spectral tracking's event probabilities (Kutz et al. 2017, history-aware
+  // schemes, event_probability.h): P_e ∝ m_e = R_i(w_i σ_e,i) for e ∈ {absorb, scatter, null}, and
+  // each lane's weight multiplied by σ_e,i / (μ̄ P_e). With one lane this is analog delta tracking.
   const int n = v.n;
   const Lanes<kLanes>& w = v.w;
   const Lanes<kLanes> sa = lanes_of<kLanes>(s.work.sigma_a, n);
@@ -388,12 +391,13 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
     ss = d * sigma_t * albedo;
     sa = d * sigma_t - ss;
     sn = lane_max(0.0f, mu - d * sigma_t);
-    const float ma = max_over(w * sa, n), ms = max_over(w * ss, n), mn = max_over(w * sn, n);
+    const EventCoefficients ev = event_coefficients(m_events[m], n, w.data(), sa.data(), ss.data(), sn.data());
+    const float ma = ev.absorb, ms = ev.scatter, mn = ev.null;
     float mf = 0.0f;
     if (m_fluorescent[m]) {
       // The fluorescent source is a fourth event, of "coefficient" d·Φ_i (evaluate_fluorescence);
       // σf itself is in σa (absorbed at the lane's own wavelength).
-      mf = max_over(w * d * lanes_of<kLanes>(std::as_const(s.cache.fl_out), n, m), n);
+      mf = event_coefficient(m_events[m], n, w.data(), d, lanes_of<kLanes>(std::as_const(s.cache.fl_out), n, m).data());
     }
     if (m_emits[m]) {
       // Emission, pbrt-v4's estimator: at every tentative collision, before the event is chosen,

@@ -126,7 +126,12 @@ TEST(SceneLoader, DefaultsWhenOptionalFieldsAreMissing) {
   EXPECT_EQ(s.settings.seed, 1u);
   EXPECT_EQ(s.settings.max_bounces, -1);
   EXPECT_EQ(s.settings.wavelength_sampling, WavelengthSampling::SpectralTracking);
+  EXPECT_EQ(s.settings.event_probabilities, EventProbabilities::Auto);
   EXPECT_EQ(s.settings.bins, spectral::BinLayout());
+  // The scheme is a scene field, so -D sets it too.
+  EXPECT_EQ(load_scene(dir / "minimal.json", {parse_scene_override("event_probabilities=implicit")})
+                .settings.event_probabilities,
+            EventProbabilities::Implicit);
 }
 
 TEST(SceneLoader, NormalisedRangesAndOrthographicCamera) {
@@ -383,6 +388,9 @@ TEST(SceneLoaderErrors, CameraAndSettings) {
   j = base_scene();
   j["wavelength_sampling"] = "hero";
   expect_error(dir, j, "wavelength_sampling", "spectral-tracking");
+  j = base_scene();
+  j["event_probabilities"] = "maximum";
+  expect_error(dir, j, "event_probabilities", "\"max\", \"average\"");
   j = base_scene();
   j["output"] = "";
   expect_error(dir, j, "output", "must not be empty");

@@ -172,6 +172,7 @@ class PathTracer {
   bool m_trilinear = false;
   int m_max_bounces = -1;
   bool m_wavelength_independent = false;
+  std::vector<EventProbabilities> m_events;  // per material: spectral tracking's scheme (event_probability.h)
 };
 
 // Largest value of a piecewise-linear spectrum over [lo_nm, hi_nm] (at the ends and the table's

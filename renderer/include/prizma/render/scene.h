@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "prizma/render/environment_map.h"
+#include "prizma/render/event_probability.h"
 #include "prizma/render/material_rule.h"
 #include "prizma/spectral/bin_layout.h"
 #include "prizma/spectral/spectrum.h"
@@ -132,6 +133,9 @@ struct RenderSettings {
   std::uint64_t seed = 1;
   int max_bounces = -1;               // −1 = unlimited (Russian roulette); ≥ 0 = cap
   WavelengthSampling wavelength_sampling = WavelengthSampling::SpectralTracking;
+  // Spectral tracking's collision event probabilities (event_probability.h); Auto: chosen from the
+  // materials' spectra when the tracer is built.
+  EventProbabilities event_probabilities = EventProbabilities::Auto;
   double target_error = 0.0;          // > 0: stop a pixel once its relative standard error ≤ this
   bool use_majorant_grid = true;
   int threads = 0;                    // 0 = all cores
