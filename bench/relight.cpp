@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -114,6 +115,92 @@ BENCHMARK_CAPTURE(BM_RelightVsStreamingSum, AVX2, std::string("AVX2"))
     ->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_RelightVsStreamingSum, SSE4, std::string("SSE4"))
     ->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// Fluorescent against plain relighting, interleaved in one run: a 512×512 image with 32 bins over
+// 380–780 nm and 2 lights, once without and once with bispectral terms (the 12 bins below 530 nm
+// re-emitting into bins 16, 20, 24 and 28: 48 pairs, |in| = 12, so K adds 3·12 floats per pixel and
+// light to the diagonal's 32). K is computed once (as the interactive session and
+// the live page keep it); each iteration relights both images under the same lights. Counters:
+// ratio = fluorescent / plain CPU time of the process (CLOCK_PROCESS_CPUTIME_ID), traffic = floats
+// read (and written) per pixel fluorescent / plain (the goal: ratio ≈ traffic), wall_ratio the same
+// in wall time, and the CPU times. CPU time because on a loaded machine the wall time of a relight
+// longer than the scheduler's time slice includes the wait for the next one (a 3 ms relight then
+// takes 30 ms of wall time at load 13, a 1.4 ms one does not: docs/results.md, "Fluorescence").
+// Arg: threads (0 = all; 1 gives the cleanest CPU times).
+const spectral::SpectralImage& fluorescent_bench_image(bool with_reradiation) {
+  static const std::vector<spectral::SpectralImage> images = [] {
+    spectral::SpectralImage img;
+    img.width = kSize / 2;
+    img.height = kSize / 2;
+    img.bins = spectral::BinLayout::linear(380.0, 780.0, kBins);
+    std::mt19937 rng(54321);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (const char* name : {"key", "back"}) {
+      spectral::TransportLayer layer;
+      layer.name = name;
+      layer.data.resize(img.pixel_count() * kBins);
+      for (float& v : layer.data) v = u(rng);
+      img.lights.push_back(std::move(layer));
+    }
+    spectral::SpectralImage fl = img;
+    for (int in = 0; in < 12; ++in)
+      for (int out : {16, 20, 24, 28}) fl.reradiation.push_back({in, out});
+    for (auto& layer : fl.lights) {
+      layer.reradiation.resize(fl.pixel_count() * fl.reradiation.size());
+      for (float& v : layer.reradiation) v = 0.05f * u(rng);
+    }
+    return std::vector<spectral::SpectralImage>{std::move(img), std::move(fl)};
+  }();
+  return images[with_reradiation ? 1 : 0];
+}
+
+void BM_FluorescentVsPlainRelight(benchmark::State& state) {
+  state.SetLabel(relight::detail::relight_simd_target());
+  std::unique_ptr<tbb::global_control> limit;
+  if (state.range(0) > 0) {
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  static_cast<std::size_t>(state.range(0)));
+  }
+  const spectral::SpectralImage& plain = fluorescent_bench_image(false);
+  const spectral::SpectralImage& fl = fluorescent_bench_image(true);
+  std::vector<relight::LightSpec> lights = {relight::parse_light_spec("LED-V1"), relight::parse_light_spec("D65*0.2")};
+  const relight::RelightMatrix matrix(plain.bins, lights, {});
+  const relight::ReradiationWeights k = relight::reradiation_weights(fl, matrix.options().cmf);
+  std::vector<float> xyz(3 * plain.pixel_count());
+  const auto cpu_s = [] {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  };
+  double plain_s = 0.0, fl_s = 0.0, plain_wall = 0.0, fl_wall = 0.0;
+  for (auto _ : state) {
+    const double c0 = cpu_s();
+    auto t0 = std::chrono::steady_clock::now();
+    relight::relight_into(plain, matrix, xyz.data());
+    benchmark::ClobberMemory();
+    const double c1 = cpu_s();
+    auto t1 = std::chrono::steady_clock::now();
+    relight::relight_into(fl, matrix, xyz.data(), &k);
+    benchmark::ClobberMemory();
+    const double c2 = cpu_s();
+    auto t2 = std::chrono::steady_clock::now();
+    plain_s += c1 - c0;
+    fl_s += c2 - c1;
+    plain_wall += std::chrono::duration<double>(t1 - t0).count();
+    fl_wall += std::chrono::duration<double>(t2 - t1).count();
+    state.SetIterationTime(std::chrono::duration<double>(t2 - t1).count());
+  }
+  const double n = static_cast<double>(state.iterations());
+  const double diag = static_cast<double>(plain.lights.size() * kBins);
+  const double rerad = static_cast<double>(fl.lights.size() * 3 * k.in_bins.size());
+  state.counters["ratio"] = fl_s / plain_s;
+  state.counters["wall_ratio"] = fl_wall / plain_wall;
+  state.counters["traffic"] = (diag + rerad + 3.0) / (diag + 3.0);  // floats read (+ 3 written) per pixel
+  state.counters["fluorescent_cpu_ms"] = 1e3 * fl_s / n;
+  state.counters["plain_cpu_ms"] = 1e3 * plain_s / n;
+}
+
+BENCHMARK(BM_FluorescentVsPlainRelight)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 // What verifying prizma:checksum costs when a file is read: read_spectral_exr of a 512×512, 32-bin,
 // two-light float file (its time includes the verification) against spectral_pixel_checksum of the

@@ -148,6 +148,23 @@ std::vector<float> reradiation_colour_weights(const SpectralImage& image, int li
   return k_out;
 }
 
+Eigen::Matrix<double, 3, Eigen::Dynamic> reradiation_pair_xyz(const SpectralImage& image, const ColorMatching& cmf,
+                                                              const LightSpectrum& light) {
+  const std::size_t np = image.reradiation.size();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> w = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, static_cast<Eigen::Index>(np));
+  if (np == 0 || light.off || light.scale == 0.0) return w;
+  const BinLayout& bins = image.bins;
+  const double y = relight_weights(cmf, light.spectrum, bins, LightUnits::Absolute).row(1).sum();
+  if (!(y > 0.0)) return w;  // relight_weights refuses such a light before this is reached
+  for (std::size_t q = 0; q < np; ++q) {
+    const BinPair& pr = image.reradiation[q];
+    const double e = light.scale / y * light.spectrum.integrate(bins.lo_nm(pr.in), bins.hi_nm(pr.in)) / bins.width_nm(pr.in);
+    for (int c = 0; c < 3; ++c)
+      w(c, static_cast<Eigen::Index>(q)) = cmf.channel(c).integrate(bins.lo_nm(pr.out), bins.hi_nm(pr.out)) * e;
+  }
+  return w;
+}
+
 namespace detail {
 
 bool parse_reradiation_channel(const std::string& name, const std::string& path, ReradiationChannel& out) {

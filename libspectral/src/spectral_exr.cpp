@@ -45,6 +45,7 @@
 #include <vector>
 
 #include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/bispectral.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
@@ -278,6 +279,7 @@ std::vector<float> preview_rgb(const SpectralImage& image) {
   const Eigen::Matrix3d to_rgb = xyz_to_linear_srgb_matrix();
   const int n = image.bins.size();
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> weights;  // per light, RGB ← bins
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> rerad;    // per light, RGB ← bispectral pairs
   bool any = false;
   for (const auto& layer : image.lights) {
     std::string spec = "D65";  // RelightSession's rule: the entry named after the layer, or the only one
@@ -289,17 +291,22 @@ std::vector<float> preview_rgb(const SpectralImage& image) {
       }
     }
     Eigen::Matrix<double, 3, Eigen::Dynamic> w = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, n);
+    Eigen::Matrix<double, 3, Eigen::Dynamic> r =
+        Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, static_cast<Eigen::Index>(image.reradiation.size()));
     try {
       const LightSpectrum light = parse_light_spectrum(spec);
       if (!light.off) {
         w = to_rgb * relight_weights(*cmf, light, image.bins);
+        r = to_rgb * reradiation_pair_xyz(image, *cmf, light);  // fluorescent files: the re-radiated light too
         any = true;
       }
     } catch (const std::exception&) {
       // left out (off)
     }
     weights.push_back(std::move(w));
+    rerad.push_back(std::move(r));
   }
+  const std::size_t np = image.reradiation.size();
   if (!any) return {};
   std::vector<float> rgb(image.pixel_count() * 3);
   for (std::size_t px = 0; px < image.pixel_count(); ++px) {
@@ -307,6 +314,10 @@ std::vector<float> preview_rgb(const SpectralImage& image) {
     for (std::size_t l = 0; l < image.lights.size(); ++l) {
       const float* t = image.lights[l].data.data() + px * static_cast<std::size_t>(n);
       for (int i = 0; i < n; ++i) sum += weights[l].col(i) * static_cast<double>(t[i]);
+      if (np > 0) {
+        const float* m = image.lights[l].reradiation.data() + px * np;
+        for (std::size_t q = 0; q < np; ++q) sum += rerad[l].col(static_cast<Eigen::Index>(q)) * static_cast<double>(m[q]);
+      }
     }
     for (int c = 0; c < 3; ++c) rgb[3 * px + static_cast<std::size_t>(c)] = std::isfinite(sum[c]) ? static_cast<float>(sum[c]) : 0.0f;
   }

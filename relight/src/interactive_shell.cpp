@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <chrono>
 #include <deque>
 #include <iomanip>
@@ -40,7 +41,8 @@ constexpr const char* kHelp =
     "  lights                the layers, their current and default lights\n"
     "  show [blocks|sixel|kitty]  draw the image in the terminal\n"
     "  save FILE             write the current image (.png, .tif, .exr)\n"
-    "  probe X Y             bins, XYZ, Lab (D65 white) and sRGB at a pixel\n"
+    "  probe X Y [LIGHT]     bins, XYZ, Lab (D65 white) and sRGB at a pixel; fluorescent files: the\n"
+    "                        excitation–emission map per light (or of LIGHT)\n"
     "  compare X1 Y1 X2 Y2 [R]  CIEDE2000 between two pixels or the means of two (2R+1)² squares\n"
     "  help                  this text\n"
     "  quit                  leave (end of input, Ctrl-D, does too)\n";
@@ -91,6 +93,57 @@ std::string ms_text(double ms) {
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The excitation–emission map of a bispectral pixel for one light: a row per emission (out) bin that
+// the file holds pairs for, longest wavelength on top, a column per excitation (in) bin; each held
+// M[out][in] as a digit 0–9 of the pixel's largest value (round(9·M/max): 9 is the largest, 0 a value
+// below 1/18 of it), '.' for zero, '\' on the diagonal (the T bins above), blank where the file holds
+// no pair.
+std::string excitation_emission_map(const spectral::SpectralImage& img, const std::string& light,
+                                    const std::vector<float>& values) {
+  std::vector<int> ins, outs;
+  float max = 0.0f;
+  std::size_t arg = 0;
+  for (std::size_t q = 0; q < img.reradiation.size(); ++q) {
+    ins.push_back(img.reradiation[q].in);
+    outs.push_back(img.reradiation[q].out);
+    if (values[q] > max) {
+      max = values[q];
+      arg = q;
+    }
+  }
+  for (auto* v : {&ins, &outs}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
+  auto nm = [&](int bin) { return std::to_string(static_cast<int>(std::lround(img.bins.centre_nm(bin)))); };
+  std::ostringstream o;
+  o << "  excitation–emission " << light << ": M[out][in] as 0–9 of its largest, ";
+  if (max > 0.0f) {
+    o << std::setprecision(4) << max << " (" << nm(img.reradiation[arg].in) << " → " << nm(img.reradiation[arg].out)
+      << " nm)";
+  } else {
+    o << "0 (no re-radiation at this pixel)";
+  }
+  o << "; . zero, \\ diagonal\n    out\\in";
+  for (int in : ins) o << std::setw(4) << nm(in);
+  o << "\n";
+  for (auto it = outs.rbegin(); it != outs.rend(); ++it) {
+    o << "    " << std::setw(6) << nm(*it);
+    for (int in : ins) {
+      char cell = ' ';
+      if (in == *it) cell = '\\';
+      for (std::size_t q = 0; q < img.reradiation.size(); ++q) {
+        if (img.reradiation[q].in != in || img.reradiation[q].out != *it) continue;
+        const float v = values[q];
+        cell = v == 0.0f || !(max > 0.0f) ? '.' : static_cast<char>('0' + std::clamp(static_cast<int>(std::lround(9.0 * v / max)), 0, 9));
+      }
+      o << "   " << cell;
+    }
+    o << "\n";
+  }
+  return o.str();
 }
 
 // The state of one session besides the RelightSession: undo levels, the drawing protocol once known.
@@ -243,8 +296,9 @@ void run_command(RelightSession& session, Shell& shell, std::ostream& out, const
     session.save(w[1]);
     out << "saved " << w[1] << " in " << ms_text(ms_since(start)) << "\n";
   } else if (cmd == "probe") {
-    expect_args(w, 2, 2, "probe X Y");
+    expect_args(w, 2, 3, "probe X Y [LIGHT]");
     const auto start = std::chrono::steady_clock::now();
+    const int only = w.size() == 4 ? session.light_index(w[3], "probe LIGHT") : -1;
     const ProbeResult r = session.probe(to_index(w[1], "probe X", width, size), to_index(w[2], "probe Y", height, size));
     out << "probe " << r.x << ' ' << r.y << "\n";
     for (std::size_t l = 0; l < r.bins.size(); ++l) {
@@ -252,6 +306,9 @@ void run_command(RelightSession& session, Shell& shell, std::ostream& out, const
       for (float v : r.bins[l]) out << ' ' << v;
       out << "\n";
     }
+    for (std::size_t l = 0; l < r.reradiation.size(); ++l)
+      if (only < 0 || static_cast<std::size_t>(only) == l)
+        out << excitation_emission_map(session.image(), session.light_names()[l], r.reradiation[l]);
     out << "  XYZ " << vec3(r.xyz) << "\n  Lab " << vec3(r.lab) << "\n  sRGB " << vec3(r.srgb) << "\n";
     out << "  " << shell.timing("probed", start);
   } else if (cmd == "compare") {
@@ -321,6 +378,7 @@ std::vector<std::string> complete_command(RelightSession& session, const std::ve
   if (cmd == "show" && arg == 1) return {"blocks", "sixel", "kitty"};
   if (cmd == "help" && arg == 1) return kCommands;
   if (cmd == "save" && arg == 1) return file_candidates(partial);
+  if (cmd == "probe" && arg == 3) return lights;
   return {};
 }
 

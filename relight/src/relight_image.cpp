@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -15,7 +16,7 @@ namespace prizma::relight {
 
 namespace {
 
-using LayerTerm = detail::SimdLayer;  // weights: 3·n floats row-major; transport: pixel-major, bins contiguous
+using LayerTerm = detail::SimdTerm;  // weights: 3·n floats row-major; values: pixel-major, n contiguous
 
 }  // namespace
 
@@ -32,50 +33,47 @@ ReradiationWeights reradiation_weights(const spectral::SpectralImage& image, spe
 
 namespace {
 
-// XYZ += output · K·ē per pixel and light: the re-radiated light, a 3×|in| product per pixel.
-void add_reradiation(const spectral::SpectralImage& image, const RelightMatrix& matrix, const ReradiationWeights& k,
-                     float* xyz_out) {
+// The re-radiation as terms of the same row pass: per light that is on, its K (3·|in| values per
+// pixel, rows c' = X, Y, Z of Σ_out cmf·M) with the 3×(3·|in|) weights W[c][c'·|in| + j] =
+// output[c][c']·ē[in_j], so that W·K = output · K·ē (docs/fluorescence.md).
+void add_reradiation_terms(const spectral::SpectralImage& image, const RelightMatrix& matrix, const ReradiationWeights& k,
+                           std::vector<float>& weights, std::vector<LayerTerm>& terms) {
   const std::size_t ni = k.in_bins.size();
   const int layers = static_cast<int>(image.lights.size());
   if (static_cast<int>(k.per_light.size()) != layers || k.cmf != matrix.options().cmf)
     throw spectral::RuntimeError("relight: re-radiation weights do not match the image or the observer");
-  std::vector<float> e(static_cast<std::size_t>(layers) * ni);
-  std::vector<int> on;
+  const std::size_t nk = 3 * ni;
+  weights.assign(static_cast<std::size_t>(layers) * 3 * nk, 0.0f);
   for (int l = 0; l < layers; ++l) {
-    if (k.per_light[static_cast<std::size_t>(l)].size() != image.pixel_count() * 3 * ni)
+    const auto& kl = k.per_light[static_cast<std::size_t>(l)];
+    if (kl.size() != image.pixel_count() * nk)
       throw spectral::RuntimeError("relight: re-radiation weights do not match the image");
-    const Eigen::VectorXd& avg = matrix.light_bin_average(l);
+    const ReradiationTermWeights wl = reradiation_term_weights(matrix, k, l);
+    float* w = weights.data() + static_cast<std::size_t>(l) * 3 * nk;
     bool any = false;
-    for (std::size_t j = 0; j < ni; ++j) {
-      e[static_cast<std::size_t>(l) * ni + j] = static_cast<float>(avg[k.in_bins[j]]);
-      any = any || avg[k.in_bins[j]] != 0.0;
+    for (std::size_t j = 0; j < 3 * nk; ++j) {
+      w[j] = static_cast<float>(wl.weights[j]);
+      any = any || w[j] != 0.0f;
     }
-    if (any) on.push_back(l);
+    if (any) terms.push_back({w, kl.data(), static_cast<int>(nk)});
   }
-  if (on.empty()) return;
-  const Eigen::Matrix3f out = matrix.output().cast<float>();
-  using Weights = Eigen::Matrix<float, 3, Eigen::Dynamic, Eigen::RowMajor>;
-  using Bins = Eigen::Matrix<float, Eigen::Dynamic, 1>;
-  const auto nk = static_cast<Eigen::Index>(ni);
-  // Rows of pixels, as the diagonal kernel: one task per row, Eigen's packets over the in bins.
-  tbb::parallel_for(tbb::blocked_range<int>(0, image.height), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y != rows.end(); ++y) {
-      const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width);
-      for (std::size_t p = first; p != first + static_cast<std::size_t>(image.width); ++p) {
-        Eigen::Vector3f v = Eigen::Vector3f::Zero();
-        for (int l : on) {
-          const Eigen::Map<const Weights> kk(k.per_light[static_cast<std::size_t>(l)].data() + p * 3 * ni, 3, nk);
-          const Eigen::Map<const Bins> el(e.data() + static_cast<std::size_t>(l) * ni, nk);
-          v.noalias() += kk.lazyProduct(el);
-        }
-        const Eigen::Vector3f add = out * v;
-        for (int c = 0; c < 3; ++c) xyz_out[3 * p + static_cast<std::size_t>(c)] += add[c];
-      }
-    }
-  });
 }
 
 }  // namespace
+
+ReradiationTermWeights reradiation_term_weights(const RelightMatrix& matrix, const ReradiationWeights& k, int light) {
+  const std::size_t ni = k.in_bins.size();
+  ReradiationTermWeights w;
+  w.values_per_pixel = static_cast<int>(3 * ni);
+  w.weights.assign(3 * 3 * ni, 0.0);
+  const Eigen::VectorXd& avg = matrix.light_bin_average(light);
+  for (int c = 0; c < 3; ++c)
+    for (int c2 = 0; c2 < 3; ++c2)
+      for (std::size_t j = 0; j < ni; ++j)
+        w.weights[static_cast<std::size_t>(c) * 3 * ni + static_cast<std::size_t>(c2) * ni + j] =
+            matrix.output()(c, c2) * avg[k.in_bins[j]];
+  return w;
+}
 
 void relight_into(const spectral::SpectralImage& image, const RelightMatrix& matrix, float* xyz_out,
                   const ReradiationWeights* k) {
@@ -100,24 +98,27 @@ void relight_into(const spectral::SpectralImage& image, const RelightMatrix& mat
                                    " has " + std::to_string(data.size()) + " values, expected " +
                                    std::to_string(image.pixel_count() * static_cast<std::size_t>(n)));
     }
-    if (!m.isZero(0.0)) terms.push_back({w, data.data()});
+    if (!m.isZero(0.0)) terms.push_back({w, data.data(), n});
+  }
+  // Bispectral images: the re-radiation joins the same pass (K once per observer: kept by the caller,
+  // else computed here for this one relight).
+  ReradiationWeights local;
+  std::vector<float> rerad_weights;
+  if (!image.reradiation.empty()) {
+    if (k == nullptr) {
+      local = reradiation_weights(image, matrix.options().cmf);
+      k = &local;
+    }
+    add_reradiation_terms(image, matrix, *k, rerad_weights, terms);
   }
   const int width = image.width;
   tbb::parallel_for(tbb::blocked_range<int>(0, image.height), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y != rows.end(); ++y) {
       const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
       // Highway's run-time dispatch: the widest SIMD this CPU has (relight_simd.cpp).
-      detail::relight_row_simd(terms.data(), static_cast<int>(terms.size()), n, first, width, xyz_out + 3 * first);
+      detail::relight_row_terms_simd(terms.data(), static_cast<int>(terms.size()), first, width, xyz_out + 3 * first);
     }
   });
-  if (!image.reradiation.empty()) {
-    if (k != nullptr) {
-      add_reradiation(image, matrix, *k, xyz_out);
-    } else {
-      const ReradiationWeights local = reradiation_weights(image, matrix.options().cmf);
-      add_reradiation(image, matrix, local, xyz_out);
-    }
-  }
 }
 
 XyzImage relight_image(const spectral::SpectralImage& image, const RelightMatrix& matrix) {

@@ -225,9 +225,13 @@ ProbeResult RelightSession::probe(int x, int y) {
   r.y = y;
   const std::size_t n = static_cast<std::size_t>(m_image.bins.size());
   const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(m_image.width) + static_cast<std::size_t>(x);
+  const std::size_t np = m_image.reradiation.size();
   for (const auto& layer : m_image.lights) {
     r.bins.emplace_back(layer.data.begin() + static_cast<std::ptrdiff_t>(p * n),
                         layer.data.begin() + static_cast<std::ptrdiff_t>((p + 1) * n));
+    if (np > 0)
+      r.reradiation.emplace_back(layer.reradiation.begin() + static_cast<std::ptrdiff_t>(p * np),
+                                 layer.reradiation.begin() + static_cast<std::ptrdiff_t>((p + 1) * np));
   }
   r.xyz = xyz().at(x, y);
   r.lab = spectral::xyz_to_lab(r.xyz, spectral::white_d65());

@@ -24,6 +24,7 @@
 #include <thread>
 
 #include "prizma/relight/serve_state.h"
+#include "prizma/spectral/bispectral.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
@@ -82,6 +83,8 @@ struct RelightServer::Impl {
   int port = 0;
   std::mutex mutex;  // guards session and caches (httplib runs handlers on a thread pool)
   std::map<std::string, std::string> display_cache;
+  // Bispectral files: K per observer, computed on first use (the page's re-radiation textures).
+  std::map<spectral::Observer, ReradiationWeights> reradiation_cache;
 
   Impl(RelightSession& s, const ServeOptions& o) : session(s), opts(o), base(s.settings()) {}
 
@@ -121,6 +124,15 @@ struct RelightServer::Impl {
     }
     spectral::DisplayOptions d = base.output.display;
     d.colour_space.clear();
+    // Bispectral files: per light ⌈3·|in|/4⌉ more texture layers after the diagonal's, holding K
+    // (X, Y, Z rows of |in| values each) for one observer.
+    json rerad = nullptr;
+    if (!img.reradiation.empty()) {
+      json pairs = json::array();
+      for (const auto& pr : img.reradiation) pairs.push_back({pr.in, pr.out});
+      const std::vector<int> in = spectral::reradiation_in_bins(img);
+      rerad = {{"inBins", in}, {"groups", texel_groups(3 * static_cast<int>(in.size()))}, {"pairs", pairs}};
+    }
     return {{"source", fs::path(session.source()).filename().string()},
             {"version", spectral::prizma_version()},
             {"width", img.width},
@@ -132,14 +144,37 @@ struct RelightServer::Impl {
             {"state", state_string(base, session)},
             {"displays", spectral::DisplayTransform(d).displays()},
             {"observers", {"1931", "1964", "2012-2", "2012-10"}},
-            {"spectra", spectral::named_illuminants()}};
+            {"spectra", spectral::named_illuminants()},
+            {"reradiation", rerad}};
   }
 
-  // One texture layer: light l, bins [4g, 4g + 4) of every pixel as RGBA texels, rows top first.
-  std::string transport(int l, int g, bool half) const {
+  int reradiation_groups() const {
     const auto& img = session.image();
-    const int n = img.bins.size();
-    const auto& data = img.lights[static_cast<std::size_t>(l)].data;
+    return img.reradiation.empty() ? 0 : texel_groups(3 * static_cast<int>(spectral::reradiation_in_bins(img).size()));
+  }
+
+  // K of every light for one observer (call with the mutex held).
+  const ReradiationWeights& reradiation(spectral::Observer cmf) {
+    auto it = reradiation_cache.find(cmf);
+    if (it == reradiation_cache.end()) it = reradiation_cache.emplace(cmf, reradiation_weights(session.image(), cmf)).first;
+    return it->second;
+  }
+
+  // One texture layer: light l, bins [4g, 4g + 4) of every pixel as RGBA texels, rows top first; for
+  // g past the diagonal's groups, values [4g', 4g' + 4) of the light's K (3·|in| per pixel) for `cmf`.
+  std::string transport(int l, int g, bool half, spectral::Observer cmf) {
+    const auto& img = session.image();
+    const int groups = texel_groups(img.bins.size());
+    const std::vector<float>* values = &img.lights[static_cast<std::size_t>(l)].data;
+    int n = img.bins.size();
+    if (g >= groups) {
+      const std::lock_guard lock(mutex);
+      const ReradiationWeights& k = reradiation(cmf);
+      values = &k.per_light[static_cast<std::size_t>(l)];
+      n = 3 * static_cast<int>(k.in_bins.size());
+      g -= groups;
+    }
+    const auto& data = *values;
     const std::size_t pixels = img.pixel_count();
     std::string out(pixels * kBinsPerTexel * (half ? sizeof(std::uint16_t) : sizeof(float)), '\0');
     for (std::size_t p = 0; p < pixels; ++p) {
@@ -160,15 +195,18 @@ struct RelightServer::Impl {
 
   json weights(const RelightSettings& s) const {
     const RelightMatrix m(session.image().bins, s.lights, s.relight);
+    ReradiationWeights in_bins;  // only the in bins: the weights of K do not depend on K
+    in_bins.in_bins = spectral::reradiation_in_bins(session.image());
     json lights = json::array();
     for (int l = 0; l < m.light_count(); ++l) {
       const Matrix3Xd& w = m.light(l);
       std::vector<double> rows;  // row-major X, Y, Z rows of n weights
       for (int c = 0; c < 3; ++c)
         for (int i = 0; i < m.bin_count(); ++i) rows.push_back(w(c, i));
-      lights.push_back({{"name", session.light_names()[static_cast<std::size_t>(l)]},
-                        {"on", !w.isZero(0.0)},
-                        {"w", rows}});
+      json light = {{"name", session.light_names()[static_cast<std::size_t>(l)]}, {"on", !w.isZero(0.0)}, {"w", rows}};
+      // Bispectral: the weights of K (3 × 3·|in|, row-major), what relight_into uses (relight_image.h).
+      if (!session.image().reradiation.empty()) light["wr"] = reradiation_term_weights(m, in_bins, l).weights;
+      lights.push_back(std::move(light));
     }
     return {{"state", state_string(s, session)}, {"lights", lights}, {"white", vec3(m.mix_white_xyz())}};
   }
@@ -262,10 +300,12 @@ void RelightServer::Impl::routes() {
   server.Get("/api/transport", guarded([this](const httplib::Request& req, httplib::Response& res) {
     const auto& img = session.image();
     const int l = int_param(req, "light", 0, static_cast<int>(img.lights.size()) - 1);
-    const int g = int_param(req, "group", 0, texel_groups(img.bins.size()) - 1);
+    const int g = int_param(req, "group", 0, texel_groups(img.bins.size()) + reradiation_groups() - 1);
     const std::string type = req.has_param("type") ? req.get_param_value("type") : "f32";
     if (type != "f32" && type != "f16") throw InputError("type", "expected f32 or f16, not \"" + type + "\"");
-    res.set_content(transport(l, g, type == "f16"), "application/octet-stream");
+    const spectral::Observer cmf =
+        req.has_param("cmf") ? spectral::parse_observer(req.get_param_value("cmf"), "cmf") : base.relight.cmf;
+    res.set_content(transport(l, g, type == "f16", cmf), "application/octet-stream");
   }));
   server.Get("/api/weights", guarded([this](const httplib::Request& req, httplib::Response& res) {
     const std::lock_guard lock(mutex);
@@ -288,7 +328,17 @@ void RelightServer::Impl::routes() {
     apply_state(req, {"x", "y"});
     const ProbeResult p = session.probe(x, y);
     json bins = json::array();  // in the file's light order
-    for (std::size_t l = 0; l < p.bins.size(); ++l) bins.push_back({{"name", session.light_names()[l]}, {"bins", p.bins[l]}});
+    const auto& pairs_held = session.image().reradiation;
+    for (std::size_t l = 0; l < p.bins.size(); ++l) {
+      json entry = {{"name", session.light_names()[l]}, {"bins", p.bins[l]}};
+      if (!p.reradiation.empty()) {  // bispectral: the pixel's off-diagonal M[out][in], as [in, out, value]
+        json pairs = json::array();
+        for (std::size_t q = 0; q < pairs_held.size(); ++q)
+          pairs.push_back({pairs_held[q].in, pairs_held[q].out, p.reradiation[l][q]});
+        entry["pairs"] = std::move(pairs);
+      }
+      bins.push_back(std::move(entry));
+    }
     send_json(res, {{"x", x}, {"y", y}, {"bins", bins}, {"xyz", vec3(p.xyz)}, {"lab", vec3(p.lab)},
                     {"srgb", vec3(p.srgb)}});
   }));

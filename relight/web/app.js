@@ -3,6 +3,9 @@
 // of four bins); each change of a control asks the server for the exact relight weights
 // (RelightMatrix, the C++ code of prizma-relight) and the display transform (OpenColorIO's own
 // GLSL), and the fragment shader computes XYZ = Σ_l M_l·T_l then the display. No colour maths here.
+// Bispectral (fluorescent) files: each light has more texture layers after its bins, its per-pixel
+// re-radiation weights K for the current observer (fetched again when the observer changes), with
+// weights from the server (wr), so the shader adds the re-radiated light in the same sum.
 'use strict';
 
 const canvas = document.getElementById('relit');
@@ -16,6 +19,10 @@ const programs = {};   // display name → {program, uniforms, textures}
 let frames = 0;
 let uiLights = {};     // light name → control state
 let lastState = '';
+let uploadedCmf = null; // bispectral files: the observer whose K the texture holds
+
+// Texture groups (4 values each) per light: the bins, then K (bispectral files only).
+function groupsPerLight() { return info.groups + (info.reradiation ? info.reradiation.groups : 0); }
 
 // ---------- server calls ----------
 
@@ -201,7 +208,7 @@ void main() {
 }`;
 
 function fragmentSource(ocio) {
-  const L = info.lights.length, G = info.groups;
+  const L = info.lights.length, G = groupsPerLight();
   // Σ_l M_l·T_l written out with constant indices (software GPUs index uniform arrays slowly).
   let sum = '';
   for (let l = 0; l < L; ++l) {
@@ -308,7 +315,7 @@ function setupGL() {
   const zoom = info.width <= room ? Math.min(8, Math.floor(room / info.width)) : room / info.width;
   canvas.style.width = Math.round(info.width * zoom) + 'px';
   canvas.style.height = Math.round(info.height * zoom) + 'px';
-  const layers = info.lights.length * info.groups;
+  const layers = info.lights.length * groupsPerLight();
   const need = 3 * layers + 8;
   if (need > gl.getParameter(gl.MAX_FRAGMENT_UNIFORM_VECTORS)) {
     throw new Error(layers * 4 + ' bins × lights need ' + need + ' uniform vectors, this GPU has ' +
@@ -324,7 +331,7 @@ function setupGL() {
 function textureType() {
   const q = new URLSearchParams(location.search).get('texture');
   if (q === 'f16' || q === 'f32') return q;
-  const bytes = info.width * info.height * 16 * info.lights.length * info.groups;
+  const bytes = info.width * info.height * 16 * info.lights.length * groupsPerLight();
   return bytes > 512 * 1024 * 1024 ? 'f16' : 'f32';
 }
 
@@ -334,7 +341,7 @@ async function uploadTransport() {
   transportTex = gl.createTexture();
   gl.activeTexture(gl.TEXTURE0);
   gl.bindTexture(gl.TEXTURE_2D_ARRAY, transportTex);
-  const layers = info.lights.length * info.groups;
+  const layers = info.lights.length * groupsPerLight();
   gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, half ? gl.RGBA16F : gl.RGBA32F, info.width, info.height, layers);
   gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
   gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
@@ -342,15 +349,31 @@ async function uploadTransport() {
   for (let l = 0; l < info.lights.length; ++l) {
     for (let g = 0; g < info.groups; ++g) {
       $('title').textContent = 'loading transport ' + (l * info.groups + g + 1) + '/' + layers + ' (' + type + ')';
-      const r = await fetch('/api/transport?light=' + l + '&group=' + g + '&type=' + type);
-      if (!r.ok) throw new Error('transport: HTTP ' + r.status);
-      const buf = await r.arrayBuffer();
-      const data = half ? new Uint16Array(buf) : new Float32Array(buf);
-      gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, l * info.groups + g, info.width, info.height, 1, gl.RGBA,
-                       half ? gl.HALF_FLOAT : gl.FLOAT, data);
+      await uploadLayer(l, g, type, '');
     }
   }
   canvas.dataset.texture = type;
+}
+
+async function uploadLayer(l, g, type, cmf) {
+  const half = type === 'f16';
+  const r = await fetch('/api/transport?light=' + l + '&group=' + g + '&type=' + type + (cmf ? '&cmf=' + enc(cmf) : ''));
+  if (!r.ok) throw new Error('transport: HTTP ' + r.status);
+  const buf = await r.arrayBuffer();
+  const data = half ? new Uint16Array(buf) : new Float32Array(buf);
+  gl.activeTexture(gl.TEXTURE0);
+  gl.bindTexture(gl.TEXTURE_2D_ARRAY, transportTex);
+  gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, l * groupsPerLight() + g, info.width, info.height, 1, gl.RGBA,
+                   half ? gl.HALF_FLOAT : gl.FLOAT, data);
+}
+
+// Bispectral files: K of every light for observer cmf into the layers after the bins.
+async function uploadReradiation(cmf) {
+  if (!info.reradiation || cmf === uploadedCmf) return;
+  for (let l = 0; l < info.lights.length; ++l)
+    for (let g = 0; g < info.reradiation.groups; ++g) await uploadLayer(l, info.groups + g, canvas.dataset.texture, cmf);
+  uploadedCmf = cmf;
+  canvas.dataset.reradiationCmf = cmf;
 }
 
 let currentWeights = null;   // Float32Array for u_w
@@ -358,7 +381,7 @@ let currentOn = null;
 let currentProgram = null;
 
 function setWeights(w) {
-  const L = info.lights.length, G = info.groups, n = info.bins.length - 1;
+  const L = info.lights.length, G = groupsPerLight(), n = info.bins.length - 1;
   const u = new Float32Array(3 * L * G * 4);
   const on = new Int32Array(L);
   w.lights.forEach((light, l) => {
@@ -368,6 +391,14 @@ function setWeights(w) {
         const g = Math.floor(i / 4);
         u[((l * G + g) * 3 + c) * 4 + (i % 4)] = light.w[c * n + i];
       }
+    if (light.wr) {  // the weights of K: 3 rows of 3·|in| values
+      const nk = light.wr.length / 3;
+      for (let c = 0; c < 3; ++c)
+        for (let j = 0; j < nk; ++j) {
+          const g = info.groups + Math.floor(j / 4);
+          u[((l * G + g) * 3 + c) * 4 + (j % 4)] = light.wr[c * nk + j];
+        }
+    }
   });
   currentWeights = u;
   currentOn = on;
@@ -404,6 +435,7 @@ async function pump() {
     try {
       const display = stateDisplay(frag);
       const [w, prog] = await Promise.all([api('/api/weights', frag), programFor(display)]);
+      await uploadReradiation(stateValue(frag, 'cmf', '1931'));
       setWeights(w);
       currentProgram = prog;
       draw();
@@ -424,11 +456,13 @@ async function pump() {
   busy = false;
 }
 
-function stateDisplay(frag) {
-  let d = 'sRGB';
-  for (const [k, v] of parseQuery(info.state).concat(parseQuery(frag))) if (k === 'display') d = v;
+function stateValue(frag, key, fallback) {
+  let d = fallback;
+  for (const [k, v] of parseQuery(info.state).concat(parseQuery(frag))) if (k === key) d = v;
   return d;
 }
+
+function stateDisplay(frag) { return stateValue(frag, 'display', 'sRGB'); }
 
 // ---------- plots, probe, compare ----------
 
@@ -495,7 +529,48 @@ async function probe(x, y) {
     const c = $('probeplot');
     plotSteps(c.getContext('2d'), r.bins.map((l, k) => ({ values: l.bins, colour: kPalette[k % kPalette.length],
                                                           label: 'T ' + l.name })), c.width, c.height, true);
+    if (info.reradiation) drawExcitationEmission(r);
   } catch (e) { $('probe').textContent = e.message; } finally { probeBusy = false; }
+}
+
+// The excitation–emission map of the probed pixel for one light: M[out][in], excitation (in) to the
+// right, emission (out) upward, one cell per bin pair; colour by value over the pixel's largest
+// off-diagonal value (kRamp); bins the file holds no pair for in #222; the diagonal (T, the plot
+// beside it) outlined. data-* attributes: the pixel, the light, the largest value, the pairs drawn.
+const kRamp = [[0, 0, 4], [87, 16, 110], [188, 55, 84], [249, 142, 9], [252, 255, 164]];
+
+function rampColour(t) {
+  const x = Math.min(Math.max(t, 0), 1) * (kRamp.length - 1);
+  const i = Math.min(Math.floor(x), kRamp.length - 2), f = x - i;
+  return kRamp[i].map((a, c) => Math.round(a + (kRamp[i + 1][c] - a) * f));
+}
+
+function drawExcitationEmission(r) {
+  const sel = $('eemlight');
+  const light = r.bins.find((l) => l.name === sel.value) || r.bins[0];
+  const c = $('eem'), ctx = c.getContext('2d');
+  const n = info.bins.length - 1, cell = Math.floor(c.width / n), size = cell * n;
+  let max = 0, arg = null;
+  for (const [i, o, v] of light.pairs) if (v > max) { max = v; arg = [i, o]; }
+  ctx.fillStyle = '#111';
+  ctx.fillRect(0, 0, c.width, c.height);
+  ctx.fillStyle = '#222';
+  ctx.fillRect(0, c.height - size, size, size);
+  for (const [i, o, v] of light.pairs) {
+    const [R, G, B] = rampColour(max > 0 ? v / max : 0);
+    ctx.fillStyle = 'rgb(' + R + ',' + G + ',' + B + ')';
+    ctx.fillRect(i * cell, c.height - (o + 1) * cell, cell, cell);
+  }
+  ctx.strokeStyle = '#777';
+  for (let i = 0; i < n; ++i) ctx.strokeRect(i * cell + 0.5, c.height - (i + 1) * cell + 0.5, cell - 1, cell - 1);
+  c.dataset.pixel = r.x + ',' + r.y;
+  c.dataset.light = light.name;
+  c.dataset.max = String(max);
+  c.dataset.cell = String(cell);
+  c.dataset.values = JSON.stringify(light.pairs);
+  const nm = (b) => (0.5 * (info.bins[b] + info.bins[b + 1])).toFixed(0);
+  $('eeminfo').textContent = 'excitation → (in), emission ↑ (out), light ' + light.name + '\nlargest M ' +
+    max.toPrecision(4) + (arg ? ' at ' + nm(arg[0]) + ' → ' + nm(arg[1]) + ' nm' : '');
 }
 
 async function compare() {
@@ -546,6 +621,11 @@ async function main() {
                              info.lights.map((l) => l.name).join(', ');
     buildLightControls();
     buildGlobalControls();
+    if (info.reradiation) {
+      $('eembox').classList.remove('hidden');
+      for (const l of info.lights) $('eemlight').add(new Option(l.name, l.name));
+      $('eemlight').addEventListener('change', () => { if (hover) probe(hover.x, hover.y); });
+    }
     setupGL();
     await uploadTransport();
     $('title').textContent = info.source + ' — ' + info.width + '×' + info.height + ', ' + (info.bins.length - 1) +

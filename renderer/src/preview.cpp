@@ -3,6 +3,7 @@
 
 #include "prizma/render/render.h"
 #include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/bispectral.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
@@ -18,14 +19,17 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
   // Per light: 3×n weights of its default spectrum (exact bin integrals), read as prizma-relight
   // reads a light: normalised so that a perfect white has Y = 1, then the spec's trailing scale
   // ("D65*0.2" stays a fifth as bright).
-  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> weights;
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> weights, rerad;  // rerad: XYZ ← bispectral pairs
   for (std::size_t l = 0; l < image.lights.size(); ++l) {
     std::string spec = "D65";
     for (const Light& light : lights)
       if (light.name == image.lights[l].name) spec = light.spectrum_spec;
     spectral::SpecContext ctx{"lights[" + std::to_string(l) + "].spectrum", opts.spectrum_base_dir};
-    weights.push_back(spectral::relight_weights(cmf, spectral::parse_light_spectrum(spec, ctx), image.bins));
+    const spectral::LightSpectrum light = spectral::parse_light_spectrum(spec, ctx);
+    weights.push_back(spectral::relight_weights(cmf, light, image.bins));
+    rerad.push_back(spectral::reradiation_pair_xyz(image, cmf, light));  // fluorescent: the re-radiated light
   }
+  const std::size_t np = image.reradiation.size();
   const double scale = std::exp2(opts.exposure_ev);
   const std::size_t pixels = image.pixel_count();
   std::vector<unsigned char> rgb8(pixels * 3);
@@ -34,6 +38,8 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
     for (std::size_t l = 0; l < image.lights.size(); ++l) {
       const float* t = image.lights[l].data.data() + p * nb;
       for (int i = 0; i < nb; ++i) xyz += weights[l].col(i) * static_cast<double>(t[i]);
+      for (std::size_t q = 0; q < np; ++q)
+        xyz += rerad[l].col(static_cast<Eigen::Index>(q)) * static_cast<double>(image.lights[l].reradiation[p * np + q]);
     }
     const Eigen::Vector3d lin = spectral::xyz_to_linear_srgb(xyz * scale);
     for (int c = 0; c < 3; ++c) {

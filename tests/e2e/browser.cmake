@@ -19,6 +19,11 @@ if(PRIZMA_E2E_MRI_EXR)
   set(_live_mri --mri ${PRIZMA_E2E_MRI_EXR})
   list(APPEND _live_fixtures mri_render)
 endif()
+# The fluorescent render of tests/e2e/fluorescence.cmake (16×16, bispectral channels), when registered.
+if(TARGET prizma-render)
+  list(APPEND _live_mri --fluor ${PRIZMA_E2E_WORK}/fluorescence/dye.exr)
+  list(APPEND _live_fixtures fluorescence_merged)
+endif()
 foreach(mode server browser)
   add_test(NAME relight.live.${mode}
            COMMAND /usr/bin/python3 ${PRIZMA_E2E_DIR}/browser/live_page_test.py ${mode}

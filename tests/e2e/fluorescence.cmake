@@ -40,3 +40,16 @@ prizma_fluorescence_e2e(single $<TARGET_FILE:prizma-render>
   FIXTURES_SETUP fluorescence_single)
 prizma_fluorescence_e2e(single_relight $<TARGET_FILE:prizma-relight> "single.exr|--light|key=LED-V1|--light|sky=off|-o|single_violet.png"
   MUST_EXIST single_violet.png FIXTURES_REQUIRED fluorescence_single)
+
+# prizma-render --preview of a fluorescent scene shows the re-radiated light: the same PNG as
+# prizma-relight -o of the render under its own lights (oiiotool --diff, no pixel may differ).
+find_program(PRIZMA_OIIOTOOL oiiotool)
+if(PRIZMA_OIIOTOOL)
+  add_test(NAME fluorescence.e2e.preview_includes_reradiation
+           COMMAND sh -c "\"$1\" \"$2\" -o pv.exr --preview pv.png --width 16 --height 16 --spp 4 --threads 2 -q && \"$3\" pv.exr -o pv_relight.png -q && \"$4\" pv.png pv_relight.png --fail 0.000001 --diff"
+                   sh $<TARGET_FILE:prizma-render> ${_fl_scene} $<TARGET_FILE:prizma-relight> ${PRIZMA_OIIOTOOL}
+           WORKING_DIRECTORY ${_fl_work})
+  set_tests_properties(fluorescence.e2e.preview_includes_reradiation PROPERTIES
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}" RESOURCE_LOCK fluorescence_e2e_work
+                       FIXTURES_REQUIRED fluorescence_shards)
+endif()

@@ -36,6 +36,10 @@ if(PRIZMA_E2E_MRI_EXR)
   set(_shell_mri --mri ${PRIZMA_E2E_MRI_EXR})
   list(APPEND _shell_fixtures mri_render)
 endif()
+if(TARGET prizma-render)  # the fluorescent render of tests/e2e/fluorescence.cmake
+  list(APPEND _shell_mri --fluor ${PRIZMA_E2E_WORK}/fluorescence/dye.exr)
+  list(APPEND _shell_fixtures fluorescence_merged)
+endif()
 add_test(NAME relight.e2e.shell_terminal
          COMMAND ${PRIZMA_PYTHON3} ${PRIZMA_E2E_DIR}/shell/tmux_shell_test.py $<TARGET_FILE:prizma-relight>
                  ${_shell_relight_work}/scene.exr ${PRIZMA_E2E_WORK}/shell_terminal ${PRIZMA_SOURCE_DATA_DIR}

@@ -1,14 +1,19 @@
 // Relighting a bispectral (fluorescent) image: out = M·E, then XYZ, through the per-pixel
 // K[c][in] = Σ_out cmf_c(out)·M[out][in] (docs/fluorescence.md), against a hand evaluation from the
 // CIE table and the light's exact shape.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "prizma/relight/relight_image.h"
+#include "prizma/spectral/colour.h"
 #include "prizma/relight/relight_matrix.h"
 #include "relight_test_util.h"
 
@@ -108,6 +113,43 @@ TEST(BispectralRelight, PrecomputedWeightsGiveTheSameImage) {
   // A light that is off adds nothing, bispectral terms included.
   const XyzImage off = relight_image(img, RelightMatrix(img.bins, lights({"off", "off"}), {}));
   for (float v : off.xyz) EXPECT_EQ(v, 0.0f);
+}
+
+TEST(BispectralRelight, PreviewChannelsIncludeTheReradiation) {
+  // The R, G, B channels written with a fluorescent image are prizma-relight's default image (each
+  // light at its recorded spectrum) in linear sRGB: the diagonal and the re-radiated light, here
+  // through relight_image's K path against the writer's per-pair sum (spectral_exr.cpp).
+  auto img = fluorescent_image();
+  img.info.lights_json = R"([{"name":"uv","spectrum":"LED-V1"},{"name":"sky","spectrum":"D65*0.2"}])";
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("prizma-bispectral-preview-" + std::to_string(::getpid()) + ".exr");
+  spectral::write_spectral_exr(path, img);
+  auto in = OIIO::ImageInput::open(path.string());
+  ASSERT_TRUE(in) << OIIO::geterror();
+  const OIIO::ImageSpec spec = in->spec();
+  std::vector<float> px(static_cast<std::size_t>(spec.width * spec.height * spec.nchannels));
+  ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+  in->close();
+  std::filesystem::remove(path);
+  const int ch[3] = {spec.channelindex("R"), spec.channelindex("G"), spec.channelindex("B")};
+  ASSERT_GE(ch[0], 0);
+  const XyzImage want = relight_image(img, RelightMatrix(img.bins, lights({"LED-V1", "D65*0.2"}), {}));
+  auto diag = img;
+  diag.reradiation.clear();
+  for (auto& l : diag.lights) l.reradiation.clear();
+  const XyzImage plain = relight_image(diag, RelightMatrix(img.bins, lights({"LED-V1", "D65*0.2"}), {}));
+  const Eigen::Matrix3d to_rgb = spectral::xyz_to_linear_srgb_matrix();
+  double largest_rerad = 0.0;
+  for (std::size_t p = 0; p < img.pixel_count(); ++p) {
+    const Eigen::Vector3d rgb = to_rgb * want.at(static_cast<int>(p) % img.width, static_cast<int>(p) / img.width);
+    const Eigen::Vector3d rgb_plain = to_rgb * plain.at(static_cast<int>(p) % img.width, static_cast<int>(p) / img.width);
+    for (int c = 0; c < 3; ++c) {
+      const double got = px[p * static_cast<std::size_t>(spec.nchannels) + static_cast<std::size_t>(ch[c])];
+      EXPECT_NEAR(got, rgb[c], 1e-5 * std::abs(rgb[c]) + 1e-6) << "pixel " << p << " channel " << c;
+      largest_rerad = std::max(largest_rerad, std::abs(rgb[c] - rgb_plain[c]));
+    }
+  }
+  EXPECT_GT(largest_rerad, 0.01);  // the re-radiation is large enough to be seen by the check
 }
 
 }  // namespace

@@ -378,6 +378,40 @@ TEST(InteractiveShell, PixelIndicesAreCheckedWithAClearError) {
   EXPECT_THROW(session.compare(0, 0, 1, 1, -1), spectral::InputError);
 }
 
+TEST(InteractiveShell, ProbeShowsTheExcitationEmissionMapOfAFluorescentPixel) {
+  // 4×2, 6 bins over 400–700 nm (centres 425 … 675), pairs from the two blue bins into the three red
+  // ones, values 0.02·(1 + (k·7 + 3l) % 11) (k = pixel·6 + pair), as in bispectral_relight_test.
+  auto img = test::make_image(4, 2, BinLayout::linear(400, 700, 6), {"uv", "sky"},
+                              [](int l, int p, int i) { return 0.05f * static_cast<float>(1 + l + p % 3 + i); });
+  img.reradiation = {{0, 3}, {0, 4}, {0, 5}, {1, 3}, {1, 4}, {1, 5}};
+  for (std::size_t l = 0; l < 2; ++l)
+    for (std::size_t k = 0; k < img.pixel_count() * 6; ++k)
+      img.lights[l].reradiation.push_back(0.02f * static_cast<float>(1 + (k * 7 + l * 3) % 11));
+  RelightSession session(std::move(img), "fluor.exr");
+  int failures = 0;
+  const std::string text = run(session, "probe 0 0\nprobe 0 0 sky\nprobe 0 0 nope\n", &failures);
+  EXPECT_EQ(failures, 1) << text;
+  // Pixel 0, light uv: (0,3) 1, (0,4) 8, (0,5) 4, (1,3) 11, (1,4) 7, (1,5) 3 times 0.02: digits
+  // round(9·v/0.22) = 1, 7, 3, 9, 6, 2; rows out 675, 625, 575 from the top, columns in 425, 475.
+  const std::string uv = "  excitation–emission uv: M[out][in] as 0–9 of its largest, 0.22 (475 → 575 nm); . zero, \\ diagonal\n"
+                         "    out\\in 425 475\n"
+                         "       675   3   2\n"
+                         "       625   7   6\n"
+                         "       575   1   9\n";
+  EXPECT_NE(text.find(uv), std::string::npos) << text;
+  // Light sky (l = 1): (k·7 + 3) % 11 for k = 0…5 → 3, 10, 6, 2, 9, 5: values 4, 11, 7, 3, 10, 6.
+  const std::string sky = "       675   6   5\n"
+                          "       625   9   8\n"
+                          "       575   3   2\n";
+  EXPECT_EQ(count(text, "excitation–emission uv"), 1u) << text;  // "probe 0 0 sky": sky's map only
+  EXPECT_EQ(count(text, "excitation–emission sky"), 2u) << text;
+  EXPECT_NE(text.find(sky), std::string::npos) << text;
+  EXPECT_NE(text.find("error: probe LIGHT: "), std::string::npos) << text;
+  // A diagonal file prints no map.
+  RelightSession plain = make_session();
+  EXPECT_EQ(run(plain, "probe 0 0\n").find("excitation"), std::string::npos);
+}
+
 TEST(InteractiveShell, ShowDrawsWithTheChosenProtocolAndShowEveryAfterChanges) {
   RelightSession session = make_session();
   InteractiveOptions opts;

@@ -12,7 +12,10 @@
                                               write the very same image
 
 WORKDIR holds two.exr and one.exr (make_fixture). With --mri FILE (a render of data/scenes/mri.json,
-lights key and env) the browser test also draws that real-data file in several states. Exit 77 (ctest SKIP_RETURN_CODE) when chromium,
+lights key and env) the browser test also draws that real-data file in several states. With --fluor
+FILE (a small render of data/scenes/fluorescent_dye.json, lights key and sky: bispectral channels)
+it draws that file too (the re-radiation included, observers switched so that K is fetched again)
+and checks the probe's excitation-emission map against the file's T.<in>nm.<out>nm channels. Exit 77 (ctest SKIP_RETURN_CODE) when chromium,
 chromedriver or selenium are missing; 1 on any failure.
 """
 import base64
@@ -214,7 +217,64 @@ return [c.width, c.height, btoa(s)];
 """
 
 
-def test_browser(relight, workdir, mri=None):
+def read_exr_channels(path):
+    """Every channel of an EXR by name, as (height, width) float arrays."""
+    import OpenImageIO as oiio
+    import numpy as np
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise RuntimeError("cannot read %s: %s" % (path, oiio.geterror()))
+    spec = inp.spec()
+    pixels = np.asarray(inp.read_image(oiio.FLOAT)).reshape(spec.height, spec.width, spec.nchannels)
+    inp.close()
+    return {name: pixels[:, :, k] for k, name in enumerate(spec.channelnames)}
+
+
+def channel_nm(nm):
+    return ("%.6f" % nm).replace(".", ",") + "nm"
+
+
+def check_excitation_emission_map(browser, srv, exr):
+    """The probe's map on the page: the pixel's M[out][in] of the chosen light, as the file holds them,
+    the largest cell drawn in the ramp's top colour."""
+    info = json.loads(http(srv.url + "api/info")[1])
+    edges = info["bins"]
+    centre = lambda b: 0.5 * (edges[b] + edges[b + 1])
+    channels = read_exr_channels(exr)
+    x, y = info["width"] // 2, info["height"] // 2
+    for light in [l["name"] for l in info["lights"]]:
+        browser.execute_script("document.getElementById('eemlight').value = arguments[0]; probe(arguments[1], arguments[2]);",
+                               light, x, y)
+        deadline = time.time() + 30
+        got = None
+        while time.time() < deadline:
+            got = browser.execute_script("const c = document.getElementById('eem'); return [c.dataset.pixel, c.dataset.light,"
+                                         " c.dataset.values, c.dataset.cell];")
+            if got[0] == "%d,%d" % (x, y) and got[1] == light:
+                break
+            time.sleep(0.05)
+        if not got or got[1] != light:
+            check(False, "excitation-emission map of light %s at (%d, %d) not drawn: %r" % (light, x, y, got))
+            continue
+        values = json.loads(got[2])
+        worst = 0.0
+        for i, o, v in values:
+            want = float(channels["%s.T.%s.%s" % (light, channel_nm(centre(i)), channel_nm(centre(o)))][y, x])
+            worst = max(worst, abs(v - want) / max(abs(want), 1e-30) if want else abs(v))
+        check(len(values) == len(info["reradiation"]["pairs"]) and worst < 1e-6,
+              "map of light %s at (%d, %d): %d pairs as the file holds them (worst relative difference %.2g)" % (
+                  light, x, y, len(values), worst))
+        # The largest value's cell is drawn in the ramp's top colour (252, 255, 164).
+        i, o, v = max(values, key=lambda t: t[2])
+        cell = int(got[3])
+        rgb = browser.execute_script(
+            "const c = document.getElementById('eem'); return Array.from(c.getContext('2d').getImageData("
+            "arguments[0], arguments[1], 1, 1).data);", int((i + 0.5) * cell), int(120 - (o + 0.5) * cell))
+        check(v > 0 and all(abs(a - b) <= 1 for a, b in zip(rgb[:3], [252, 255, 164])),
+              "map of light %s: the largest pair (%d → %d, %.4g) drawn in the top colour (%r)" % (light, i, o, v, rgb))
+
+
+def test_browser(relight, workdir, mri=None, fluor=None):
     chromium = shutil.which("chromium")
     driver_path = shutil.which("chromedriver") or ("/usr/bin/chromedriver" if os.path.exists("/usr/bin/chromedriver") else None)
     try:
@@ -257,6 +317,15 @@ def test_browser(relight, workdir, mri=None):
             (mri, "light.key=F11&light.env=LED-B3*0.5&exposure=-0.5&cmf=2012-2&display=sRGB&adapt=0",
              "the MRI render, F11 and a blue LED"),
         ]
+    if fluor:
+        cases += [
+            (fluor, "light.key=LED-V1&light.sky=off&exposure=0&cmf=1931&display=sRGB&adapt=0",
+             "the fluorescent render under a violet LED (re-radiation)"),
+            (fluor, "light.key=LED-V1&light.sky=D65*0.2&exposure=0.5&cmf=1964&display=Display%20P3&adapt=1",
+             "the fluorescent render, 1964 observer (K fetched again), P3, adapted"),
+            (fluor, "light.key=D65&light.sky=D65*0.2&exposure=0&cmf=2012-2&display=sRGB&adapt=0",
+             "the fluorescent render under its own lights, CIE 2012 2°"),
+        ]
     servers = {}
     refs = {}
     try:
@@ -297,6 +366,8 @@ def test_browser(relight, workdir, mri=None):
             status, body = http(srv.url + "api/save?file=saved.png&" + state, "POST")
             saved = read_png(os.path.join(workdir, "saved.png")) if status == 200 else None
             check(saved is not None and np.array_equal(saved, ref), "%s: Save writes prizma-relight's image" % what)
+        if fluor and fluor in servers:
+            check_excitation_emission_map(browser, servers[fluor], fluor)
         frames = browser.execute_script("return Number(document.getElementById('relit').dataset.frame);")
         check(frames >= 2, "data-frame counts the frames drawn (%d)" % frames)
         # The comparisons can fail: the states differ from each other.
@@ -312,16 +383,20 @@ def test_browser(relight, workdir, mri=None):
 
 def main():
     args = sys.argv[1:]
-    mri = None
+    mri = fluor = None
     if "--mri" in args:
         i = args.index("--mri")
         mri = os.path.abspath(args[i + 1])
+        del args[i:i + 2]
+    if "--fluor" in args:
+        i = args.index("--fluor")
+        fluor = os.path.abspath(args[i + 1])
         del args[i:i + 2]
     if len(args) != 3 or args[0] not in ("server", "browser"):
         print(__doc__)
         return 2
     mode, relight, workdir = args[0], os.path.abspath(args[1]), os.path.abspath(args[2])
-    rc = test_server(relight, workdir) if mode == "server" else test_browser(relight, workdir, mri)
+    rc = test_server(relight, workdir) if mode == "server" else test_browser(relight, workdir, mri, fluor)
     if rc == SKIP:
         return SKIP
     if failures:

@@ -11,7 +11,11 @@ server is killed at the end whatever happened.
 With --mri FILE a fifth session runs on that file (a render of data/scenes/mri.json): light names
 completed from its layers (key, env), a light changed and switched off, a probe, a show.
 
-usage: tmux_shell_test.py EXE SCENE.exr WORKDIR DATA_DIR [--transcript FILE] [--mri FILE]
+With --fluor FILE (a small render of data/scenes/fluorescent_dye.json, bispectral channels) a sixth
+session probes a pixel of the dyed sphere: the excitation-emission map of each light, and of one light
+named after the coordinates, with its largest value as the digit 9.
+
+usage: tmux_shell_test.py EXE SCENE.exr WORKDIR DATA_DIR [--transcript FILE] [--mri FILE] [--fluor FILE]
 """
 import os
 import re
@@ -125,6 +129,11 @@ def main():
     if "--mri" in args:
         i = args.index("--mri")
         mri = os.path.abspath(args[i + 1])
+        del args[i:i + 2]
+    fluor = None
+    if "--fluor" in args:
+        i = args.index("--fluor")
+        fluor = os.path.abspath(args[i + 1])
         del args[i:i + 2]
     exe, scene, work, data = args
     shutil.rmtree(work, ignore_errors=True)
@@ -263,6 +272,31 @@ def main():
             pane.type("quit")
             pane.key("Enter")
             pane.wait("the MRI session to end", lambda s: "[exited 0]" in s)
+        if fluor:
+            # Session 6: a fluorescent render, the pixel probe's excitation-emission map.
+            pane.start(session_command(exe, fluor, env))
+            screen = pane.wait_prompt(1)
+            expect("relit in " in screen and "error" not in screen, "the fluorescent file did not open", screen)
+            pane.command("light key LED-V1")
+            screen = pane.command("probe 8 8")
+            for light in ("key", "sky"):
+                expect(f"excitation–emission {light}: M[out][in] as 0–9 of its largest" in screen,
+                       f"probe printed no excitation-emission map for light {light}", screen)
+            expect(re.search(r"out\\in( +[0-9]{3})+\n", screen) is not None, "the map has no in-bin header", screen)
+            rows = re.findall(r"^ +[0-9]{3}(?:   [0-9.\\ ])+$", screen, flags=re.M)
+            expect(len(rows) >= 2 and any("9" in r for r in rows), "the map has no rows with its largest value 9", screen)
+            n = pane.prompts()
+            pane.type("probe 8 8 s")
+            pane.key("Tab")
+            pane.wait("a light name completed after probe X Y", lambda s: pane.last_line() == f"{PROMPT} probe 8 8 sky")
+            pane.key("Enter")
+            screen = pane.wait_prompt(n + 1)
+            tail = screen[screen.rfind("probe 8 8 sky"):]
+            expect("excitation–emission sky" in tail and "excitation–emission key" not in tail,
+                   "probe X Y LIGHT did not restrict the map to that light", tail)
+            pane.type("quit")
+            pane.key("Enter")
+            pane.wait("the fluorescent session to end", lambda s: "[exited 0]" in s)
         print("terminal session test passed")
         return 0
     except Failure as e:

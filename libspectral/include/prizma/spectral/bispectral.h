@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "prizma/spectral/colour_matching.h"
+#include "prizma/spectral/light_spectrum.h"
 #include "prizma/spectral/spectral_exr.h"
 
 namespace prizma::spectral {
@@ -35,5 +37,13 @@ void add_reradiated(const SpectralImage& image, int light, const std::vector<dou
 std::vector<float> reradiation_colour_weights(const SpectralImage& image, int light,
                                               const Eigen::Matrix<double, 3, Eigen::Dynamic>& c_out,
                                               const std::vector<int>& in_bins);
+
+// Per pair of image.reradiation, the XYZ that a unit M[out][in] adds under `light` (normalised as
+// relight_weights normalises it, so a white has Y = 1 at scale 1, then times its scale): column q is
+// C[:, out_q]·ē[in_q], C the CMFs integrated over each bin, ē the light's bin averages; 3 × pairs,
+// zero for a light that is off. A pixel's re-radiated XYZ is Σ_q M_q·column q (the R, G, B preview
+// channels of the spectral EXR and prizma-render --preview; prizma-relight goes through K instead).
+Eigen::Matrix<double, 3, Eigen::Dynamic> reradiation_pair_xyz(const SpectralImage& image, const ColorMatching& cmf,
+                                                              const LightSpectrum& light);
 
 }  // namespace prizma::spectral

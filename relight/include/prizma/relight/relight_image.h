@@ -21,6 +21,15 @@ struct ReradiationWeights {
 };
 ReradiationWeights reradiation_weights(const spectral::SpectralImage& image, spectral::Observer cmf);
 
+// The weights that relight_into gives light `light`'s K in its row pass (and the live page its K
+// textures): 3 rows (X, Y, Z) × values_per_pixel = 3·|in bins|, W[c][c'·|in| + j] =
+// output()[c][c']·ē[in_bins[j]], so W·K = output · K·ē. Double; relight_into rounds them to float.
+struct ReradiationTermWeights {
+  int values_per_pixel = 0;
+  std::vector<double> weights;  // row-major, 3 × values_per_pixel
+};
+ReradiationTermWeights reradiation_term_weights(const RelightMatrix& matrix, const ReradiationWeights& k, int light);
+
 // The same into a caller-owned buffer of 3·width·height floats (reused across interactive relights).
 // For a bispectral image, `k` (for the matrix's observer) is used when given, else computed.
 void relight_into(const spectral::SpectralImage& image, const RelightMatrix& matrix, float* xyz_out,

@@ -29,6 +29,9 @@ struct RelightSettings {
 struct ProbeResult {
   int x = 0, y = 0;
   std::vector<std::vector<float>> bins;  // per layer, the transport bins at the pixel
+  // Bispectral files: per layer the pixel's off-diagonal M[out][in], one value per pair of
+  // image().reradiation (empty otherwise).
+  std::vector<std::vector<float>> reradiation;
   Eigen::Vector3d xyz;                   // relit, exposure included
   Eigen::Vector3d lab;                   // CIELAB, D65 white (Y = 1)
   Eigen::Vector3d srgb;                  // sRGB (IEC 61966-2-1) encoded, unclamped
