@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <clocale>
+#include <cstdio>
 #include <cmath>
 #include <sstream>
 #include <iostream>
@@ -276,7 +277,11 @@ int run_compress(const std::string& input, const std::string& output, const reli
     for (const auto& layer : t.lights) {
       std::cout << layer.name << ": k = " << layer.k << " of " << t.bins.size() << " bins; ΔE00 p"
                 << options.criterion.percentile << " / max:";
-      for (const auto& e : layer.errors) std::cout << "  " << e.light << " " << e.percentile << " / " << e.max;
+      for (const auto& e : layer.errors) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, " %.3f / %.3f", e.percentile, e.max);
+        std::cout << "  " << e.light << buf;
+      }
       std::cout << "\n";
     }
     std::cout << "wrote " << output
