@@ -3,7 +3,8 @@
 // (relight_compressed_into over k coefficients per light), both through the same DisplayEncoder8
 // (the shipped OCIO config's sRGB display, matrix applied and curve baked), interleaved in one run.
 // Counters: exact_ms, compressed_ms (whole frame), their relight and encode parts, ratio =
-// exact ÷ compressed, k per light, and the compressed frame's error against the exact one: ΔE00
+// exact ÷ compressed, fused_ms (relight_compressed_to_display8, the manual time reported) with
+// exact_over_fused and unfused_over_fused, the load average at start and end, k per light, and the compressed frame's error against the exact one: ΔE00
 // p99 and max over all pixels (Lab relative to the mix's white) and the 8-bit codes that differ.
 // Arg: threads (0 = all).
 //
@@ -18,9 +19,9 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
-#include <random>
 #include <string>
 
+#include "bench_image.h"
 #include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/relight_image.h"
 #include "prizma/spectral/colour.h"
@@ -35,43 +36,10 @@ constexpr int kHeight = 2160;
 constexpr int kBins = 16;
 
 // Smooth spectra that vary over the image (four Gaussian shapes mixed by smooth weights) with ±0.0005
-// uniform noise: a converged render's transport, not a noisy one.
+// uniform noise: a converged render's transport, not a noisy one (bench_image.h).
 const spectral::SpectralImage& bench_image() {
-  static const spectral::SpectralImage image = [] {
-    spectral::SpectralImage img;
-    img.width = kWidth;
-    img.height = kHeight;
-    img.bins = spectral::BinLayout::linear(400.0, 700.0, kBins);
-    std::mt19937 rng(12345);
-    std::uniform_real_distribution<float> noise(-0.0005f, 0.0005f);
-    float shape[4][kBins];
-    for (int j = 0; j < 4; ++j)
-      for (int i = 0; i < kBins; ++i) {
-        const double d = (img.bins.centre_nm(i) - (430.0 + 80.0 * j)) / 45.0;
-        shape[j][i] = static_cast<float>(0.05 + std::exp(-0.5 * d * d));
-      }
-    for (const char* name : {"key", "back"}) {
-      spectral::TransportLayer layer;
-      layer.name = name;
-      layer.data.resize(img.pixel_count() * kBins);
-      const float phase = layer.name == "key" ? 0.0f : 1.3f;
-      for (int y = 0; y < kHeight; ++y) {
-        for (int x = 0; x < kWidth; ++x) {
-          const float u = static_cast<float>(x) / kWidth, v = static_cast<float>(y) / kHeight;
-          const float a[4] = {0.5f + 0.5f * std::sin(6.0f * u + phase), 0.5f + 0.5f * std::cos(5.0f * v + phase),
-                              u * v, 0.3f * (1.0f - u)};
-          float* t = layer.data.data() + (static_cast<std::size_t>(y) * kWidth + x) * kBins;
-          for (int i = 0; i < kBins; ++i) {
-            float s = 0.0f;
-            for (int j = 0; j < 4; ++j) s += a[j] * shape[j][i];
-            t[i] = std::max(0.0f, 0.5f * s + noise(rng));
-          }
-        }
-      }
-      img.lights.push_back(std::move(layer));
-    }
-    return img;
-  }();
+  static const spectral::SpectralImage image = bench::make_bench_image(
+      kWidth, kHeight, spectral::BinLayout::linear(400.0, 700.0, kBins), bench::BenchSpectra::Smooth);
   return image;
 }
 
@@ -87,11 +55,8 @@ double percentile(std::vector<double> v, double q) {
 }
 
 void BM_ExactVsCompressed4K(benchmark::State& state) {
-  std::unique_ptr<tbb::global_control> limit;
-  if (state.range(0) > 0) {
-    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                  static_cast<std::size_t>(state.range(0)));
-  }
+  const auto limit = bench::limit_threads(state.range(0));
+  const double load_start = bench::load_average();
   const spectral::SpectralImage& img = bench_image();
   const relight::CompressedTransport& comp = bench_transport();
   const std::vector<relight::LightSpec> lights = {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")};
@@ -99,8 +64,9 @@ void BM_ExactVsCompressed4K(benchmark::State& state) {
   const spectral::DisplayTransform display(spectral::DisplayOptions{});
   const relight::DisplayEncoder8 encoder(display);
   std::vector<float> xyz_exact(3 * img.pixel_count()), xyz_comp(3 * img.pixel_count());
-  std::vector<std::uint8_t> rgb_exact(3 * img.pixel_count()), rgb_comp(3 * img.pixel_count());
-  double exact_relight = 0, exact_encode = 0, comp_relight = 0, comp_encode = 0;
+  std::vector<std::uint8_t> rgb_exact(3 * img.pixel_count()), rgb_comp(3 * img.pixel_count()),
+      rgb_fused(3 * img.pixel_count());
+  double exact_relight = 0, exact_encode = 0, comp_relight = 0, comp_encode = 0, fused = 0;
   using clock = std::chrono::steady_clock;
   auto secs = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
   for (auto _ : state) {
@@ -113,12 +79,15 @@ void BM_ExactVsCompressed4K(benchmark::State& state) {
     const auto t3 = clock::now();
     encoder.encode(xyz_comp.data(), img.pixel_count(), rgb_comp.data());
     const auto t4 = clock::now();
+    relight::relight_compressed_to_display8(comp, matrix, encoder, rgb_fused.data());
+    const auto t5 = clock::now();
     benchmark::ClobberMemory();
     exact_relight += secs(t0, t1);
     exact_encode += secs(t1, t2);
     comp_relight += secs(t2, t3);
     comp_encode += secs(t3, t4);
-    state.SetIterationTime(secs(t2, t4));
+    fused += secs(t4, t5);
+    state.SetIterationTime(secs(t4, t5));
   }
   const double n = static_cast<double>(state.iterations());
   state.counters["exact_ms"] = 1e3 * (exact_relight + exact_encode) / n;
@@ -127,6 +96,14 @@ void BM_ExactVsCompressed4K(benchmark::State& state) {
   state.counters["compressed_relight_ms"] = 1e3 * comp_relight / n;
   state.counters["encode_ms"] = 1e3 * (exact_encode + comp_encode) / (2 * n);
   state.counters["ratio"] = (exact_relight + exact_encode) / (comp_relight + comp_encode);
+  // The fused frame (relight_compressed_to_display8: one pass, display matrix folded in, small table,
+  // Highway SIMD): its ms, exact frame ÷ fused and unfused compressed frame ÷ fused.
+  state.counters["fused_ms"] = 1e3 * fused / n;
+  state.counters["exact_over_fused"] = (exact_relight + exact_encode) / fused;
+  state.counters["unfused_over_fused"] = (comp_relight + comp_encode) / fused;
+  state.counters["small_lut"] = encoder.small_lut(0).empty() ? 0 : static_cast<double>(encoder.small_lut(0).size());
+  state.counters["load_start"] = load_start;
+  state.counters["load_end"] = bench::load_average();
   state.counters["baked"] = encoder.baked() ? 1 : 0;
   for (std::size_t l = 0; l < comp.lights.size(); ++l) state.counters["k_" + comp.lights[l].name] = comp.lights[l].k;
   // Errors of the last compressed frame against the exact one, every pixel.
@@ -148,6 +125,15 @@ void BM_ExactVsCompressed4K(benchmark::State& state) {
   }
   state.counters["codes_differ_pct"] = 100.0 * static_cast<double>(differ) / static_cast<double>(rgb_exact.size());
   state.counters["codes_max_diff"] = worst;
+  std::size_t fused_differ = 0;
+  int fused_worst = 0;
+  for (std::size_t i = 0; i < rgb_comp.size(); ++i) {
+    const int d = std::abs(int{rgb_fused[i]} - int{rgb_comp[i]});
+    fused_differ += d != 0;
+    fused_worst = std::max(fused_worst, d);
+  }
+  state.counters["fused_vs_unfused_differ_pct"] = 100.0 * static_cast<double>(fused_differ) / static_cast<double>(rgb_comp.size());
+  state.counters["fused_vs_unfused_max_diff"] = fused_worst;
 }
 
 BENCHMARK(BM_ExactVsCompressed4K)->Arg(2)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(3.0);

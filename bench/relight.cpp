@@ -18,8 +18,8 @@
 #include <filesystem>
 #include <memory>
 #include <string>
-#include <random>
 
+#include "bench_image.h"
 #include "prizma/relight/relight_image.h"
 #include "prizma/relight/relight_matrix.h"
 #include "prizma/relight/relight_simd.h"
@@ -33,22 +33,8 @@ constexpr int kSize = 1024;
 constexpr int kBins = 32;
 
 const spectral::SpectralImage& bench_image() {
-  static const spectral::SpectralImage image = [] {
-    spectral::SpectralImage img;
-    img.width = kSize;
-    img.height = kSize;
-    img.bins = spectral::BinLayout::linear(380.0, 780.0, kBins);
-    std::mt19937 rng(12345);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    for (const char* name : {"key", "back"}) {
-      spectral::TransportLayer layer;
-      layer.name = name;
-      layer.data.resize(img.pixel_count() * kBins);
-      for (float& v : layer.data) v = u(rng);
-      img.lights.push_back(std::move(layer));
-    }
-    return img;
-  }();
+  static const spectral::SpectralImage image =
+      bench::make_bench_image(kSize, kSize, spectral::BinLayout::linear(380.0, 780.0, kBins), bench::BenchSpectra::Uniform);
   return image;
 }
 
@@ -74,11 +60,7 @@ double streaming_sum(const spectral::SpectralImage& img) {
 void BM_RelightVsStreamingSum(benchmark::State& state, const std::string& target) {
   relight::detail::relight_simd_force_target(target);
   state.SetLabel(relight::detail::relight_simd_target());
-  std::unique_ptr<tbb::global_control> limit;
-  if (state.range(0) > 0) {
-    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                  static_cast<std::size_t>(state.range(0)));
-  }
+  const auto limit = bench::limit_threads(state.range(0));
   const spectral::SpectralImage& img = bench_image();
   std::vector<relight::LightSpec> lights = {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")};
   const relight::RelightMatrix matrix(img.bins, lights, {});

@@ -53,6 +53,7 @@
 #include "prizma/spectral/light_spectrum.h"
 #include "prizma/spectral/tool_main.h"
 #include "bispectral_exr.h"
+#include "coefficients_exr.h"
 #include "text_util.h"
 
 namespace prizma::spectral {
@@ -241,6 +242,7 @@ std::string checksum_string(std::uint64_t sum, const char* scheme = kChecksumSch
 std::uint64_t light_layers_hash(const SpectralImage& image) {
   std::uint64_t sum = 0;
   for (const auto& light : image.lights) {
+    if (light.data.empty()) continue;  // a compact file: coefficients only
     sum += layer_hash(light.data.data(), light.data.size(), kFnvBasisLight);
     if (!light.variance.empty()) sum += layer_hash(light.variance.data(), light.variance.size(), kFnvBasisVariance);
   }
@@ -298,6 +300,11 @@ std::vector<float> preview_rgb(const SpectralImage& image) {
       if (!light.off) {
         w = to_rgb * relight_weights(*cmf, light, image.bins);
         r = to_rgb * reradiation_pair_xyz(image, *cmf, light);  // fluorescent files: the re-radiated light too
+        if (layer.data.empty()) {  // compact: RGB ← coefficients through the basis (n×k, vector-major)
+          const int k = layer.coefficients.k;
+          const Eigen::Map<const Eigen::MatrixXf> basis(layer.coefficients.basis.data(), n, k);
+          w = Eigen::Matrix<double, 3, Eigen::Dynamic>(w * basis.cast<double>());
+        }
         any = true;
       }
     } catch (const std::exception&) {
@@ -312,11 +319,14 @@ std::vector<float> preview_rgb(const SpectralImage& image) {
   for (std::size_t px = 0; px < image.pixel_count(); ++px) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (std::size_t l = 0; l < image.lights.size(); ++l) {
-      const float* t = image.lights[l].data.data() + px * static_cast<std::size_t>(n);
-      for (int i = 0; i < n; ++i) sum += weights[l].col(i) * static_cast<double>(t[i]);
+      const TransportLayer& layer = image.lights[l];
+      const int m = layer.data.empty() ? layer.coefficients.k : n;
+      const float* t = layer.data.empty() ? layer.coefficients.values.data() + px * static_cast<std::size_t>(m)
+                                          : layer.data.data() + px * static_cast<std::size_t>(n);
+      for (int i = 0; i < m; ++i) sum += weights[l].col(i) * static_cast<double>(t[i]);
       if (np > 0) {
-        const float* m = image.lights[l].reradiation.data() + px * np;
-        for (std::size_t q = 0; q < np; ++q) sum += rerad[l].col(static_cast<Eigen::Index>(q)) * static_cast<double>(m[q]);
+        const float* rm = layer.reradiation.data() + px * np;
+        for (std::size_t q = 0; q < np; ++q) sum += rerad[l].col(static_cast<Eigen::Index>(q)) * static_cast<double>(rm[q]);
       }
     }
     for (int c = 0; c < 3; ++c) rgb[3 * px + static_cast<std::size_t>(c)] = std::isfinite(sum[c]) ? static_cast<float>(sum[c]) : 0.0f;
@@ -333,6 +343,7 @@ std::string spectral_pixel_checksum(const SpectralImage& image) {
     sum += layer_hash(total.data(), total.size(), kFnvBasisSum);
   }
   sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
+  sum += detail::coefficients_checksum(image);  // 0 without spectral-basis coefficients
   return checksum_string(sum);
 }
 
@@ -384,10 +395,17 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   if (image.lights.empty()) throw InputError(p, "the image has no light layers");
   const int bins = image.bins.size();
   const std::size_t expected = image.pixel_count() * static_cast<std::size_t>(bins);
+  // Compact: spectral-basis coefficients only, no bins (prizma-relight compress --compact).
+  const bool compact = image.compact();
+  if (compact && !image.reradiation.empty()) throw InputError(p, "a compact file cannot hold bispectral (fluorescent) terms");
   std::set<std::string> names;
   for (const auto& light : image.lights) {
     check_exr_light_name(light.name, p);
     if (!names.insert(light.name).second) throw InputError(p, "two lights are named \"" + light.name + "\"");
+    if (compact) {
+      if (!light.variance.empty()) throw InputError(p, "light \"" + light.name + "\": a compact file has no variance layers");
+      continue;
+    }
     if (light.data.size() != expected) {
       throw InputError(p, "light \"" + light.name + "\" has " + std::to_string(light.data.size()) +
                               " values, expected width·height·bins = " + std::to_string(expected));
@@ -404,7 +422,9 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   const bool multi = image.lights.size() >= 2;
   std::vector<float> sum;
   std::vector<OutLayer> layers;
-  if (multi) {
+  if (compact) {
+    // no transport layers
+  } else if (multi) {
     sum = sum_of_lights(image);
     check_finite(sum, image.width, bins, "sum of all lights", p);
     layers.push_back({"", &sum, "sum of all lights", LayerKind::Sum});
@@ -537,8 +557,14 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   }
   // Bispectral channels (fluorescence; none, and the header unchanged, for a diagonal image).
   detail::ReradiationBuffers rerad_buffers;
-  if (const std::uint64_t rc = detail::add_reradiation_for_write(image, multi, half_out, header, fb, rerad_buffers, p); rc != 0)
-    header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum + rc)));
+  if (const std::uint64_t rc = detail::add_reradiation_for_write(image, multi, half_out, header, fb, rerad_buffers, p); rc != 0) {
+    checksum += rc;
+    header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum)));
+  }
+  // Spectral-basis coefficients (float32 whatever the pixel type; none for most files).
+  if (const std::uint64_t cc = detail::add_coefficients_for_write(image, multi, header, fb, p); cc != 0) {
+    header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum + cc)));
+  }
   if (!preview.empty()) {
     const char* base = half_out ? reinterpret_cast<const char*>(preview_half.data())
                                 : reinterpret_cast<const char*>(preview.data());
@@ -795,6 +821,7 @@ void verify_checksum(const std::string& p, const Imf::Header& header, const std:
     std::uint64_t sum = light_layers_hash(image);
     if (top != nullptr) sum += layer_hash(top->data(), top->size(), kFnvBasisSum);
     sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
+    sum += detail::coefficients_checksum(image);  // 0 without spectral-basis coefficients
     expected = checksum_string(sum);
   } else if (stored.rfind(kChecksumSchemeV1, 0) == 0) {
     expected = checksum_string(light_layers_hash(image), kChecksumSchemeV1);
@@ -834,7 +861,12 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     std::map<std::string, LayerChannels> layers;  // by layer prefix ("" = top level)
     bool any_emissive = false;
     std::vector<detail::ReradiationChannel> rerad_channels;  // bispectral T.<λin>.<λout>
+    std::vector<detail::CoefficientChannel> coef_channels;   // spectral-basis [<light>.]coef.<j>
     for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      if (detail::CoefficientChannel cc; detail::parse_coefficient_channel(it.name(), cc)) {
+        coef_channels.push_back(std::move(cc));
+        continue;
+      }
       if (detail::ReradiationChannel rc; detail::parse_reradiation_channel(it.name(), p, rc)) {
         rerad_channels.push_back(std::move(rc));
         continue;
@@ -847,7 +879,14 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
       }
       layers[parsed->layer].channels.emplace_back(parsed->lambda_nm, it.name());
     }
-    if (layers.empty()) {
+    // Compact: coefficients and no bins (prizma-relight compress --compact).
+    const bool compact = layers.empty() && !coef_channels.empty();
+    if (compact && !opts.allow_compact) {
+      throw InputError(p, "compact file: it holds spectral-basis coefficients per pixel and light (prizma-relight compress "
+                          "--compact), not the transport bins; only prizma-relight relights it (from the coefficients)");
+    }
+    if (compact && !rerad_channels.empty()) throw InputError(p, "compact file with bispectral channels");
+    if (layers.empty() && !compact) {
       if (any_emissive) {
         throw InputError(p, "emissive-only spectral EXR (S0..S3 channels): Prizma reads reflective T.<λ>nm "
                             "channels only");
@@ -890,6 +929,17 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
       return layer == kVarianceLayer || (layer.size() > 4 && layer.compare(layer.size() - 4, 4, ".var") == 0);
     };
     std::vector<std::string> light_layers;
+    std::set<std::string> compact_layers;  // a compact file: the coefficient channels' layers
+    for (const auto& c : coef_channels) compact_layers.insert(c.layer);
+    if (compact && compact_layers.size() > 1) compact_layers.erase("");
+    for (const auto& name : compact ? std::vector<std::string>(compact_layers.begin(), compact_layers.end())
+                                    : std::vector<std::string>()) {
+      if (name.empty()) continue;
+      if (!valid_light_name(name)) {
+        throw InputError(p, "layer \"" + name + "\" is not a valid light name (letters, digits, '_' and '-')");
+      }
+      light_layers.push_back(name);
+    }
     for (const auto& [name, layer] : layers) {
       if (name.empty() || is_variance(name)) continue;
       if (!valid_light_name(name)) {
@@ -921,7 +971,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
         sources.push_back({l, l, layers.count(l + ".var") ? l + ".var" : std::string()});
       }
     } else {
-      if (!layers.count("")) {
+      if (!layers.count("") && !compact) {
         throw InputError(p, "only variance layers, no spectral T.<wavelength>nm layer");
       }
       std::string name = "default";
@@ -930,7 +980,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     }
 
     // Every light (and the top level and variance layers) must carry the same wavelengths.
-    const std::vector<double> lambdas = layers.at(sources.front().layer).lambdas();
+    const std::vector<double> lambdas = compact ? std::vector<double>() : layers.at(sources.front().layer).lambdas();
     auto check_same = [&](const std::string& layer, const std::string& what) {
       const auto other = layers.at(layer).lambdas();
       if (other != lambdas) {
@@ -939,16 +989,22 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
       }
     };
     for (const auto& s : sources) {
+      if (compact) break;
       check_same(s.layer, s.layer.empty() ? "the top-level layer" : "layer \"" + s.layer + "\"");
       if (!s.variance.empty()) check_same(s.variance, "variance layer \"" + s.variance + "\"");
     }
     if (!light_layers.empty() && layers.count("")) check_same("", "the top-level layer");
-    const int n = static_cast<int>(lambdas.size());
+    int n = static_cast<int>(lambdas.size());
 
     // Bin edges: prizma:binEdgesNm (checked against the centres), else midpoints between centres.
+    // A compact file has no channels to check them against.
     std::vector<double> edges;
     if (const auto recorded = edges_attribute(header, kAttrEdges, p)) {
       const std::vector<double>& fe = *recorded;
+      if (compact) {
+        if (fe.size() < 2) throw InputError(p, std::string(kAttrEdges) + " has " + std::to_string(fe.size()) + " edges");
+        n = static_cast<int>(fe.size()) - 1;
+      }
       if (fe.size() != static_cast<std::size_t>(n) + 1) {
         throw InputError(p, std::string(kAttrEdges) + " has " + std::to_string(fe.size()) + " edges for " +
                                 std::to_string(n) + " spectral channels (expected " + std::to_string(n + 1) + ")");
@@ -968,7 +1024,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
         }
         if (agree) edges = exact;
       }
-      for (int i = 0; i < n; ++i) {
+      for (int i = 0; i < n && !compact; ++i) {
         if (!(lambdas[static_cast<std::size_t>(i)] > edges[static_cast<std::size_t>(i)] &&
               lambdas[static_cast<std::size_t>(i)] < edges[static_cast<std::size_t>(i) + 1])) {
           std::ostringstream os;
@@ -992,6 +1048,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
         }
       }
     } else {
+      if (compact) throw InputError(p, "compact file without prizma:binEdgesNm: its bins are unknown");
       if (n < 2) throw InputError(p, "a single spectral channel without prizma:binEdgesNm gives no bin width");
       edges.resize(static_cast<std::size_t>(n) + 1);
       for (int i = 1; i < n; ++i) edges[i] = 0.5 * (lambdas[i - 1] + lambdas[i]);
@@ -1011,7 +1068,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
       TransportLayer& light = image.lights.emplace_back();
       light.name = s.name;
     }
-    for (std::size_t k = 0; k < sources.size(); ++k) {
+    for (std::size_t k = 0; k < sources.size() && !compact; ++k) {
       TransportLayer& light = image.lights[k];
       light.data.assign(count, 0.0f);
       add_slices(fb, layers.at(sources[k].layer), light.data, dw, n);
@@ -1027,6 +1084,14 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     }
     // The top-level T layer of a file with named light layers, read only to verify it (checksum v2).
     const std::string* stored = opts.verify_checksum ? find_string_attr(header, kAttrChecksum) : nullptr;
+    // Spectral-basis coefficients: kept with read_coefficients (always in a compact file), else read
+    // only to verify the checksum.
+    const bool keep_coefficients = opts.read_coefficients || compact;
+    if (keep_coefficients || stored != nullptr) {
+      std::vector<std::string> light_prefixes;
+      for (const auto& s : sources) light_prefixes.push_back(s.layer);
+      detail::add_coefficients_for_read(coef_channels, header, light_prefixes, n, image, fb, dw, p);
+    }
     std::vector<float> top;
     const bool read_top = stored != nullptr && stored->rfind(kChecksumScheme, 0) == 0 && !light_layers.empty() &&
                           layers.count("") != 0;
@@ -1040,6 +1105,11 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     // A file written with a checksum must give back exactly what was written: PIZ has no check of
     // its own, so a damaged but complete file could otherwise read as other, finite values.
     if (stored != nullptr) verify_checksum(p, header, *stored, image, read_top ? &top : nullptr);
+    detail::check_coefficients_finite(image, p);
+    if (!keep_coefficients) {
+      for (auto& light : image.lights) light.coefficients = LayerCoefficients{};
+      image.coefficient_criterion.clear();
+    }
     for (std::size_t k = 0; k < sources.size(); ++k) {
       const std::string what = sources[k].layer.empty() ? "layer T" : "layer \"" + sources[k].layer + "\"";
       check_finite(image.lights[k].data, image.width, n, what, p);

@@ -6,14 +6,17 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <clocale>
+#include <cstdio>
 #include <cmath>
 #include <sstream>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "prizma/relight/batch_file.h"
+#include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/interactive_shell.h"
 #include "prizma/relight/output_image.h"
 #include "prizma/relight/relight_session.h"
@@ -63,6 +66,7 @@ struct CliOptions {
   int port = 0;
   std::string save_dir = ".";
   bool no_verify = false;
+  bool exact = false;
 };
 
 const char* cmf_table(spectral::Observer obs) {
@@ -159,9 +163,17 @@ int run(const CliOptions& o) {
 
   spectral::ExrReadOptions read_options;
   read_options.verify_checksum = !o.no_verify;
+  // Spectral-basis coefficients (prizma-relight compress) are relit when present, unless --exact;
+  // the live page draws the bins on the GPU, so --serve reads them (and refuses a compact file).
+  read_options.read_coefficients = !o.exact && !o.serve;
+  read_options.allow_compact = true;
   relight::RelightSession session = spectral::allocating("reading " + o.input, [&] {
-    return relight::RelightSession(spectral::read_spectral_exr(o.input, read_options), o.input);
+    return relight::RelightSession(spectral::read_spectral_exr(o.input, read_options), o.input, o.exact);
   });
+  if (o.serve && session.image().compact()) {
+    throw InputError(o.input, "compact file: it holds only spectral-basis coefficients, and the live page (--serve) "
+                              "needs the transport bins; serve the file it was made from");
+  }
   const relight::RelightSettings cli_settings = settings_from(o, session);
   session.apply(cli_settings);
   if (!o.output.empty()) {
@@ -180,6 +192,12 @@ int run(const CliOptions& o) {
     const std::string coverage =
         spectral::cmf_coverage_note(spectral::ColorMatching::get(s.relight.cmf), session.image().bins);
     if (!coverage.empty()) std::cerr << "prizma-relight: note: " << coverage << "\n";
+    if (const relight::CompressedTransport* c = session.coefficients()) {
+      std::string ks;
+      for (const auto& layer : c->lights) ks += (ks.empty() ? "" : ", ") + layer.name + " k = " + std::to_string(layer.k);
+      std::cerr << "prizma-relight: relighting from spectral-basis coefficients (" << ks
+                << (session.image().compact() ? "; compact file, no bins" : "; --exact uses the bins") << ")\n";
+    }
     std::istringstream lights(session.describe_lights());
     for (std::string line; std::getline(lights, line);) std::cerr << "prizma-relight: light " << line << "\n";
   }
@@ -238,9 +256,69 @@ int run(const CliOptions& o) {
   return spectral::kExitOk;
 }
 
+// prizma-relight compress IN.exr -o OUT.exr [--compact] [--max-error DE]: adds spectral-basis
+// coefficients to a spectral EXR (docs/relight.md, "Compressed transport").
+int run_compress(const std::string& input, const std::string& output, const relight::CompressFileOptions& options,
+                 bool quiet) {
+  spectral::require_regular_file(input, "an OpenEXR file");
+  spectral::check_output_file(output, "--output");
+  std::filesystem::path out_path(output);
+  if (out_path.extension() != ".exr") {
+    throw InputError("--output", output + ": the compressed file is a spectral EXR: give it the extension .exr");
+  }
+  std::error_code ec;
+  if (std::filesystem::equivalent(input, output, ec)) {
+    throw InputError("--output", output + " is the input file: write the compressed file beside it");
+  }
+  const relight::CompressedTransport t = spectral::allocating("compressing " + input, [&] {
+    return relight::compress_spectral_exr(input, output, options);
+  });
+  if (!quiet) {
+    for (const auto& layer : t.lights) {
+      std::cout << layer.name << ": k = " << layer.k << " of " << t.bins.size() << " bins; ΔE00 p"
+                << options.criterion.percentile << " / max:";
+      for (const auto& e : layer.errors) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, " %.3f / %.3f", e.percentile, e.max);
+        std::cout << "  " << e.light << buf;
+      }
+      std::cout << "\n";
+    }
+    std::cout << "wrote " << output
+              << (options.compact ? " (compact: coefficients only, relightable by prizma-relight alone)" : "")
+              << "\n";
+  }
+  return spectral::kExitOk;
+}
+
+int compress_main(int argc, char** argv) {
+  CLI::App app{"Adds spectral-basis coefficients to a spectral EXR (relit from them, much faster).",
+               "prizma-relight compress"};
+  std::string input, output;
+  relight::CompressFileOptions options;
+  bool no_verify = false, quiet = false;
+  int threads = 0;
+  app.add_option("input", input, "spectral EXR with transport bins")->required();
+  app.add_option("-o,--output", output, "the compressed spectral EXR (written atomically)")->required();
+  app.add_flag("--compact", options.compact,
+               "drop the transport bins (and variance): the file is then relit only from the coefficients");
+  app.add_option("--max-error", options.criterion.max_delta_e,
+                 "CIEDE2000 bound at the 99th percentile of the pixels, per layer, under D65, A, F11 and a 20 nm blue LED")
+      ->capture_default_str();
+  app.add_flag("--no-verify", no_verify, "read the input even when its pixels do not match prizma:checksum");
+  app.add_flag("-q,--quiet", quiet, "print nothing but errors");
+  app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  options.verify_checksum = !no_verify;
+  std::optional<tbb::global_control> limit;
+  if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
+  return spectral::run_tool("prizma-relight", [&] { return run_compress(input, output, options, quiet); });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string_view(argv[1]) == "compress") return compress_main(argc - 1, argv + 1);
   CLI::App app{"Relights a Prizma spectral EXR under any light spectra (no re-render).", "prizma-relight"};
   CliOptions o;
   app.add_option("input", o.input, "spectral EXR written by prizma-render (or any reflective spectral EXR)")
@@ -271,11 +349,15 @@ int main(int argc, char** argv) {
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_flag("--no-verify", o.no_verify,
                "read the input even when its pixels do not match prizma:checksum (a file re-encoded by another tool)");
+  app.add_flag("--exact", o.exact,
+               "relight from the transport bins even when the file carries spectral-basis coefficients");
   app.add_flag("--serve", o.serve, "serve the live relighting page (prints its URL; Ctrl-C stops it)");
   app.add_option("--bind", o.bind, "--serve: address to listen on")->capture_default_str();
   app.add_option("--port", o.port, "--serve: port (0: a free one)")->check(CLI::Range(0, 65535))->capture_default_str();
   app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")->capture_default_str();
   app.set_version_flag("--version", prizma::spectral::prizma_version());
+  app.footer("Also: prizma-relight compress IN.exr -o OUT.exr [--compact] [--max-error DE] adds spectral-basis "
+             "coefficients (prizma-relight compress --help).");
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
   o.display_given = app.count("--display") > 0;
   std::optional<tbb::global_control> threads;

@@ -9,7 +9,12 @@
 #include <cmath>
 #include <limits>
 
+#include "compressed_simd.h"
+#include "prizma/relight/relight_image.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/spectral_exr.h"
+
+#include <nlohmann/json.hpp>
 
 namespace prizma::relight {
 
@@ -60,6 +65,34 @@ AddRow add_row_for(int k) {
   }
 }
 
+// Per layer of the transport, W_l = A·M_l·B_l as float, row-major (3·k), where A is `display`
+// (XYZ → linear display RGB) or the identity; empty for lights that are off. The shape checks and the
+// "off" rule are relight_into's (light_weights, relight_image.h).
+std::vector<std::vector<float>> coefficient_weights(const CompressedTransport& transport, const RelightMatrix& matrix,
+                                                    const Eigen::Matrix3f* display) {
+  const int n = transport.bins.size();
+  const int layers = static_cast<int>(transport.lights.size());
+  const std::vector<LightWeights> on = light_weights(matrix, layers, n, "compressed transport");
+  const std::size_t pixels = transport.pixel_count();
+  for (const CompressedLayer& layer : transport.lights) {
+    if (layer.k < 1 || layer.basis.rows() != n || layer.basis.cols() != layer.k ||
+        layer.coefficients.size() != pixels * static_cast<std::size_t>(layer.k)) {
+      throw spectral::RuntimeError("relight: compressed layer " + layer.name + " has inconsistent sizes");
+    }
+  }
+  std::vector<std::vector<float>> out(static_cast<std::size_t>(layers));
+  for (const LightWeights& lw : on) {
+    const CompressedLayer& layer = transport.lights[static_cast<std::size_t>(lw.light)];
+    Eigen::Matrix<double, 3, Eigen::Dynamic> w = matrix.light(lw.light) * layer.basis.cast<double>();
+    if (display != nullptr) w = Eigen::Matrix<double, 3, Eigen::Dynamic>(display->cast<double>() * w);
+    std::vector<float>& row_major = out[static_cast<std::size_t>(lw.light)];
+    row_major.resize(3 * static_cast<std::size_t>(layer.k));
+    for (int c = 0; c < 3; ++c)
+      for (int j = 0; j < layer.k; ++j) row_major[static_cast<std::size_t>(c * layer.k + j)] = static_cast<float>(w(c, j));
+  }
+  return out;
+}
+
 std::uint8_t quantise(float v) {
   // What OpenImageIO does converting float to uint8: clamp, scale, round half up.
   const float c = std::clamp(v, 0.0f, 1.0f);
@@ -95,32 +128,14 @@ CompressedTransport compress_transport(const spectral::SpectralImage& image, con
 }
 
 void relight_compressed_into(const CompressedTransport& transport, const RelightMatrix& matrix, float* xyz_out) {
-  const int n = transport.bins.size();
-  const int layers = static_cast<int>(transport.lights.size());
-  if (matrix.light_count() != layers || matrix.bin_count() != n) {
-    throw spectral::RuntimeError("relight: matrix is " + std::to_string(matrix.light_count()) + " lights × " +
-                                 std::to_string(matrix.bin_count()) + " bins, compressed transport has " +
-                                 std::to_string(layers) + " × " + std::to_string(n));
-  }
-  const std::size_t pixels = transport.pixel_count();
   // W_l = M_l·B_l once per light setting, float, row-major; "off" lights are skipped.
-  std::vector<std::vector<float>> weights;
+  const std::vector<std::vector<float>> weights = coefficient_weights(transport, matrix, nullptr);
   std::vector<CoeffTerm> terms;
   std::vector<AddRow> kernels;
-  for (int l = 0; l < layers; ++l) {
-    const CompressedLayer& layer = transport.lights[static_cast<std::size_t>(l)];
-    if (layer.k < 1 || layer.basis.rows() != n || layer.basis.cols() != layer.k ||
-        layer.coefficients.size() != pixels * static_cast<std::size_t>(layer.k)) {
-      throw spectral::RuntimeError("relight: compressed layer " + layer.name + " has inconsistent sizes");
-    }
-    const Matrix3Xd& m = matrix.light(l);
-    if (m.isZero(0.0)) continue;
-    const Eigen::Matrix<double, 3, Eigen::Dynamic> w = m * layer.basis.cast<double>();
-    std::vector<float> row_major(3 * static_cast<std::size_t>(layer.k));
-    for (int c = 0; c < 3; ++c)
-      for (int j = 0; j < layer.k; ++j) row_major[static_cast<std::size_t>(c * layer.k + j)] = static_cast<float>(w(c, j));
-    weights.push_back(std::move(row_major));
-    terms.push_back({weights.back().data(), layer.coefficients.data(), layer.k});
+  for (std::size_t t = 0; t < weights.size(); ++t) {
+    if (weights[t].empty()) continue;
+    const CompressedLayer& layer = transport.lights[t];
+    terms.push_back({weights[t].data(), layer.coefficients.data(), layer.k});
     kernels.push_back(add_row_for(layer.k));
   }
   const int width = transport.width;
@@ -209,9 +224,10 @@ DisplayEncoder8::DisplayEncoder8(const spectral::DisplayTransform& display) : m_
     m_guess[c].resize(0x7F80);
     for (std::uint32_t b = 0; b < 0x7F80; ++b) {
       const float v = std::bit_cast<float>(b << 16);
-      m_guess[c][b] = static_cast<std::uint8_t>(std::upper_bound(thr.begin() + 1, thr.end(), v) - (thr.begin() + 1));
+      m_guess[c][b] = static_cast<std::uint8_t>(std::upper_bound(thr.begin() + 1, thr.begin() + 256, v) - (thr.begin() + 1));
     }
   }
+  for (auto& thr : m_thresholds) thr[256] = std::numeric_limits<float>::infinity();
   // Check the bake against the full transform on deterministic colours, dark ones and negatives too.
   constexpr std::size_t kChecks = 4096;
   std::vector<float> xyz(3 * kChecks);
@@ -236,6 +252,66 @@ DisplayEncoder8::DisplayEncoder8(const spectral::DisplayTransform& display) : m_
     if (std::abs(ref - int{fast[i]}) > 1) {
       m_baked = false;
       break;
+    }
+  }
+  if (m_baked) build_small_lut();
+}
+
+// The small table: buckets of equal width over [0, top], narrower than the closest two code steps
+// of any channel (so that at most one step lies in a bucket and one comparison corrects the guess),
+// at most 65536 entries; each bucket holds the code of a value just below its lower edge. Checked
+// against the thresholds (both sides of every step, and 4096 spread values) before it is used.
+void DisplayEncoder8::build_small_lut() {
+  float top = 0.0f, gap = std::numeric_limits<float>::infinity();
+  for (const auto& thr : m_thresholds) {
+    float prev = 0.0f;
+    for (std::size_t j = 1; j < 256; ++j) {
+      if (!std::isfinite(thr[j])) break;
+      if (thr[j] > 0.0f) {
+        gap = std::min(gap, thr[j] - prev);
+        prev = thr[j];
+      }
+      top = std::max(top, thr[j]);
+    }
+  }
+  if (!(top > 0.0f) || !(gap > 0.0f)) return;
+  top *= 1.001f;
+  const double needed = 1.05 * static_cast<double>(top) / static_cast<double>(gap);
+  if (needed > 65536.0) return;
+  std::size_t size = 64;
+  while (static_cast<double>(size) < needed) size *= 2;
+  const float scale = static_cast<float>(static_cast<double>(size) / static_cast<double>(top));
+  auto guess_code = [&](std::size_t c, float v) {
+    const auto& thr = m_thresholds[c];
+    return static_cast<std::uint8_t>(std::upper_bound(thr.begin() + 1, thr.begin() + 256, v) - (thr.begin() + 1));
+  };
+  for (std::size_t c = 0; c < 3; ++c) {
+    m_small[c].resize(size);
+    for (std::size_t b = 0; b < size; ++b) {
+      const float v = std::max(0.0f, static_cast<float>((static_cast<double>(b) - 0.01) / static_cast<double>(scale)));
+      m_small[c][b] = guess_code(c, v);
+    }
+  }
+  m_small_scale = scale;
+  auto small_code = [&](std::size_t c, float v) {
+    const float x = std::min(std::max(v, 0.0f) * scale, static_cast<float>(size - 1));
+    std::uint32_t code = static_cast<std::uint32_t>(m_small[c][static_cast<std::size_t>(x)]);
+    if (std::max(v, 0.0f) >= m_thresholds[c][code + 1]) ++code;
+    return code;
+  };
+  for (std::size_t c = 0; c < 3; ++c) {
+    std::vector<float> probes = {0.0f, -1.0f, top, 2.0f * top, 1e30f};
+    for (std::size_t j = 1; j < 256 && std::isfinite(m_thresholds[c][j]); ++j) {
+      probes.push_back(m_thresholds[c][j]);
+      probes.push_back(std::nextafter(m_thresholds[c][j], -1.0f));
+    }
+    for (int i = 0; i < 4096; ++i) probes.push_back(top * static_cast<float>(i) / 4000.0f);
+    for (const float v : probes) {
+      if (small_code(c, v) != guess_code(c, std::max(v, 0.0f))) {
+        for (auto& t : m_small) t.clear();
+        m_small_scale = 0.0f;
+        return;
+      }
     }
   }
 }
@@ -281,6 +357,122 @@ void DisplayEncoder8::encode(const float* xyz, std::size_t pixels, std::uint8_t*
       const std::size_t first = i * kChunk;
       const std::size_t count = std::min(kChunk, pixels - first);
       encode_chunk(xyz + 3 * first, count, rgb + 3 * first);
+    }
+  });
+}
+
+}  // namespace prizma::relight
+
+namespace prizma::relight {
+
+CompressedTransport take_coefficients(spectral::SpectralImage& image, const std::string& source) {
+  if (!image.has_coefficients()) throw spectral::InputError(source, "has no spectral-basis coefficients");
+  CompressedTransport out;
+  out.width = image.width;
+  out.height = image.height;
+  out.bins = image.bins;
+  const int n = image.bins.size();
+  for (spectral::TransportLayer& layer : image.lights) {
+    spectral::LayerCoefficients& c = layer.coefficients;
+    if (c.basis.size() != static_cast<std::size_t>(c.k) * static_cast<std::size_t>(n) ||
+        c.values.size() != static_cast<std::size_t>(c.k) * image.pixel_count()) {
+      throw spectral::InputError(source, "the coefficients of light \"" + layer.name + "\" have inconsistent sizes");
+    }
+    CompressedLayer l;
+    l.name = layer.name;
+    l.k = c.k;
+    l.basis = Eigen::Map<const Eigen::MatrixXf>(c.basis.data(), n, c.k);
+    l.coefficients = std::move(c.values);
+    c.values.clear();
+    l.errors = c.errors;
+    out.lights.push_back(std::move(l));
+  }
+  return out;
+}
+
+std::string criterion_json(const spectral::BasisCriterion& criterion) {
+  const nlohmann::json j = {{"maxDeltaE00", criterion.max_delta_e},
+                            {"percentile", criterion.percentile},
+                            {"lights", criterion.lights},
+                            {"cmf", spectral::observer_name(criterion.cmf)},
+                            {"maxSamples", criterion.max_samples}};
+  return j.dump();
+}
+
+void store_coefficients(spectral::SpectralImage& image, const CompressedTransport& transport,
+                        const spectral::BasisCriterion& criterion, bool compact) {
+  if (transport.lights.size() != image.lights.size() || transport.width != image.width ||
+      transport.height != image.height || transport.bins.size() != image.bins.size()) {
+    throw spectral::RuntimeError("store_coefficients: the compressed transport does not match the image");
+  }
+  for (std::size_t l = 0; l < image.lights.size(); ++l) {
+    const CompressedLayer& c = transport.lights[l];
+    spectral::TransportLayer& layer = image.lights[l];
+    layer.coefficients.k = c.k;
+    layer.coefficients.basis.assign(c.basis.data(), c.basis.data() + c.basis.size());  // column-major: vector-major
+    layer.coefficients.values = c.coefficients;
+    layer.coefficients.errors = c.errors;
+    if (compact) {
+      layer.data = {};
+      layer.variance = {};
+    }
+  }
+  image.coefficient_criterion = criterion_json(criterion);
+}
+
+CompressedTransport compress_spectral_exr(const std::filesystem::path& input, const std::filesystem::path& output,
+                                          const CompressFileOptions& options) {
+  const spectral::BasisCriterion& criterion = options.criterion;
+  if (!std::isfinite(criterion.max_delta_e) || criterion.max_delta_e <= 0.0) {
+    throw spectral::InputError("--max-error", "must be a positive CIEDE2000 difference, e.g. 0.5");
+  }
+  spectral::ExrReadOptions read;
+  read.verify_checksum = options.verify_checksum;
+  read.allow_compact = true;  // to say what it is, below
+  spectral::SpectralImage image = spectral::read_spectral_exr(input, read);
+  if (image.compact()) {
+    throw spectral::InputError(input.string(), "is a compact file (coefficients only, no transport bins): compress "
+                                               "needs the bins; compress the file it was made from");
+  }
+  if (!image.reradiation.empty()) {
+    throw spectral::InputError(input.string(), "is a bispectral (fluorescent) file: the coefficients would leave out its "
+                                               "re-radiation terms, so compress does not take it");
+  }
+  const CompressedTransport transport = compress_transport(image, criterion);
+  store_coefficients(image, transport, criterion, options.compact);
+  spectral::write_spectral_exr(output, image);
+  return transport;
+}
+
+void relight_compressed_to_display8(const CompressedTransport& transport, const RelightMatrix& matrix,
+                                    const DisplayEncoder8& encoder, std::uint8_t* rgb_out) {
+  const std::size_t pixels = transport.pixel_count();
+  if (!encoder.baked() || encoder.small_lut(0).empty()) {
+    std::vector<float> xyz(3 * pixels);
+    relight_compressed_into(transport, matrix, xyz.data());
+    encoder.encode(xyz.data(), pixels, rgb_out);
+    return;
+  }
+  const std::vector<std::vector<float>> weights = coefficient_weights(transport, matrix, &encoder.matrix());
+  std::vector<detail::SimdCoeffLayer> terms;
+  for (std::size_t t = 0; t < weights.size(); ++t) {
+    if (weights[t].empty()) continue;
+    terms.push_back({weights[t].data(), transport.lights[t].coefficients.data(), transport.lights[t].k});
+  }
+  detail::SimdEncoder enc;
+  for (int c = 0; c < 3; ++c) {
+    enc.lut[c] = encoder.small_lut(c).data();
+    enc.thresholds[c] = encoder.thresholds(c);
+  }
+  enc.lut_size = static_cast<int>(encoder.small_lut(0).size());
+  enc.lut_scale = encoder.small_lut_scale();
+  const int width = transport.width;
+  tbb::parallel_for(tbb::blocked_range<int>(0, transport.height), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<float> scratch(3 * static_cast<std::size_t>(width) + 64);
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
+      detail::compressed_row_to_display8(terms.data(), static_cast<int>(terms.size()), first, width, enc, scratch.data(),
+                                         rgb_out + 3 * first);
     }
   });
 }

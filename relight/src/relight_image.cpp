@@ -75,31 +75,41 @@ ReradiationTermWeights reradiation_term_weights(const RelightMatrix& matrix, con
   return w;
 }
 
+std::vector<LightWeights> light_weights(const RelightMatrix& matrix, int layers, int bins, const std::string& what) {
+  if (matrix.light_count() != layers || matrix.bin_count() != bins) {
+    throw spectral::RuntimeError("relight: matrix is " + std::to_string(matrix.light_count()) + " lights × " +
+                                 std::to_string(matrix.bin_count()) + " bins, " + what + " has " +
+                                 std::to_string(layers) + " × " + std::to_string(bins));
+  }
+  std::vector<LightWeights> on;
+  for (int l = 0; l < layers; ++l) {
+    const Matrix3Xd& m = matrix.light(l);
+    if (m.isZero(0.0)) continue;
+    LightWeights& w = on.emplace_back();
+    w.light = l;
+    w.weights.resize(3 * static_cast<std::size_t>(bins));
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < bins; ++i) w.weights[static_cast<std::size_t>(c * bins + i)] = static_cast<float>(m(c, i));
+  }
+  return on;
+}
+
 void relight_into(const spectral::SpectralImage& image, const RelightMatrix& matrix, float* xyz_out,
                   const ReradiationWeights* k) {
   const int n = image.bins.size();
   const int layers = static_cast<int>(image.lights.size());
-  if (matrix.light_count() != layers || matrix.bin_count() != n) {
-    throw spectral::RuntimeError("relight: matrix is " + std::to_string(matrix.light_count()) + " lights × " +
-                                 std::to_string(matrix.bin_count()) + " bins, image has " +
-                                 std::to_string(layers) + " × " + std::to_string(n));
-  }
-  // Row-major float weights per light; lights whose matrix is zero ("off") are skipped entirely.
-  std::vector<float> weights(static_cast<std::size_t>(layers) * 3 * static_cast<std::size_t>(n));
-  std::vector<LayerTerm> terms;
+  const std::vector<LightWeights> on = light_weights(matrix, layers, n, "image");
   for (int l = 0; l < layers; ++l) {
-    const Matrix3Xd& m = matrix.light(l);
-    float* w = weights.data() + static_cast<std::size_t>(l) * 3 * static_cast<std::size_t>(n);
-    for (int c = 0; c < 3; ++c)
-      for (int i = 0; i < n; ++i) w[c * n + i] = static_cast<float>(m(c, i));
     const auto& data = image.lights[static_cast<std::size_t>(l)].data;
     if (data.size() != image.pixel_count() * static_cast<std::size_t>(n)) {
       throw spectral::RuntimeError("relight: layer " + image.lights[static_cast<std::size_t>(l)].name +
                                    " has " + std::to_string(data.size()) + " values, expected " +
                                    std::to_string(image.pixel_count() * static_cast<std::size_t>(n)));
     }
-    if (!m.isZero(0.0)) terms.push_back({w, data.data(), n});
   }
+  std::vector<LayerTerm> terms;
+  for (const LightWeights& w : on)
+    terms.push_back({w.weights.data(), image.lights[static_cast<std::size_t>(w.light)].data.data(), n});
   // Bispectral images: the re-radiation joins the same pass (K once per observer: kept by the caller,
   // else computed here for this one relight).
   ReradiationWeights local;

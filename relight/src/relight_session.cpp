@@ -93,9 +93,20 @@ Eigen::Vector3d xyz_to_srgb_encoded(const Eigen::Vector3d& xyz) {
 RelightSession::RelightSession(const std::filesystem::path& spectral_exr)
     : RelightSession(spectral::read_spectral_exr(spectral_exr), spectral_exr.string()) {}
 
-RelightSession::RelightSession(spectral::SpectralImage image, std::string source)
+RelightSession::RelightSession(spectral::SpectralImage image, std::string source, bool exact)
     : m_image(std::move(image)), m_source(std::move(source)) {
   if (m_image.lights.empty()) throw InputError(m_source, "no transport layers");
+  if (m_image.has_coefficients()) {
+    if (exact && m_image.compact()) {
+      throw InputError(m_source, "compact file: it holds only spectral-basis coefficients, not the transport bins, so "
+                                 "it cannot be relit exactly (relight it without --exact, or use the file it was made from)");
+    }
+    if (exact) {
+      for (auto& layer : m_image.lights) layer.coefficients = spectral::LayerCoefficients{};
+    } else {
+      m_compressed = std::make_unique<CompressedTransport>(take_coefficients(m_image, m_source));
+    }
+  }
   for (const auto& layer : m_image.lights) m_light_names.push_back(layer.name.empty() ? "T" : layer.name);
   DefaultLights defaults = read_default_lights(m_image, m_light_names, m_source);
   m_default_lights = std::move(defaults.lights);
@@ -196,7 +207,11 @@ double RelightSession::relight() {
   m_xyz.xyz.resize(3 * m_image.pixel_count());
   if (!m_image.reradiation.empty() && (m_reradiation.per_light.empty() || m_reradiation.cmf != m_matrix.options().cmf))
     m_reradiation = reradiation_weights(m_image, m_matrix.options().cmf);  // once per observer
-  relight_into(m_image, m_matrix, m_xyz.xyz.data(), m_image.reradiation.empty() ? nullptr : &m_reradiation);
+  if (m_compressed) {
+    relight_compressed_into(*m_compressed, m_matrix, m_xyz.xyz.data());
+  } else {
+    relight_into(m_image, m_matrix, m_xyz.xyz.data(), m_image.reradiation.empty() ? nullptr : &m_reradiation);
+  }
   m_dirty = false;
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -226,7 +241,14 @@ ProbeResult RelightSession::probe(int x, int y) {
   const std::size_t n = static_cast<std::size_t>(m_image.bins.size());
   const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(m_image.width) + static_cast<std::size_t>(x);
   const std::size_t np = m_image.reradiation.size();
-  for (const auto& layer : m_image.lights) {
+  for (std::size_t l = 0; l < m_image.lights.size(); ++l) {
+    const auto& layer = m_image.lights[l];
+    if (layer.data.empty() && m_compressed) {  // compact: the bins as the coefficients give them, B·c
+      const CompressedLayer& c = m_compressed->lights[l];
+      const Eigen::VectorXf t = c.basis * Eigen::Map<const Eigen::VectorXf>(c.coefficients.data() + p * static_cast<std::size_t>(c.k), c.k);
+      r.bins.emplace_back(t.data(), t.data() + t.size());
+      continue;
+    }
     r.bins.emplace_back(layer.data.begin() + static_cast<std::ptrdiff_t>(p * n),
                         layer.data.begin() + static_cast<std::ptrdiff_t>((p + 1) * n));
     if (np > 0)
@@ -294,6 +316,7 @@ ImageMetadata RelightSession::metadata() const {
     md.emplace_back("prizma:colourSpace", m_settings.output.display.colour_space);
   }
   md.emplace_back("prizma:display", m_settings.output.display.display);
+  if (m_compressed) md.emplace_back("prizma:relitFrom", "spectral-basis coefficients");
   return md;
 }
 

@@ -13,6 +13,8 @@
 #include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/output_image.h"
 #include "prizma/relight/relight_image.h"
+#include "prizma/relight/relight_session.h"
+#include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "relight_test_util.h"
 
@@ -154,6 +156,136 @@ TEST(DisplayEncoder8, AColourSpaceConversionIsAMatrixAndBakesToo) {
   for (std::size_t i = 0; i < 9; ++i) {
     EXPECT_NEAR(int{out[i]}, std::floor(std::clamp(ref[i], 0.0f, 1.0f) * 255.0f + 0.5f), 1.0) << i;
   }
+}
+
+TEST(LightWeights, SkipsLightsThatAreOffAndChecksTheShape) {
+  const auto bins = spectral::BinLayout::linear(400.0, 700.0, 8);
+  const RelightMatrix m(bins, {parse_light_spec("off"), parse_light_spec("D65")}, {});
+  const std::vector<LightWeights> on = light_weights(m, 2, 8, "image");
+  ASSERT_EQ(on.size(), 1u);
+  EXPECT_EQ(on[0].light, 1);
+  ASSERT_EQ(on[0].weights.size(), 24u);
+  EXPECT_FLOAT_EQ(on[0].weights[8 + 3], static_cast<float>(m.light(1)(1, 3)));  // Y row, bin 3
+  EXPECT_THROW(light_weights(m, 3, 8, "image"), spectral::RuntimeError);
+  EXPECT_THROW(light_weights(m, 2, 9, "image"), spectral::RuntimeError);
+}
+
+// The fused frame (coefficients → 8-bit codes per row, display matrix folded into the weights)
+// against relight_compressed_into + DisplayEncoder8::encode: the same codes but for float rounding.
+TEST(DisplayEncoder8, FusedFrameEqualsRelightThenEncode) {
+  const auto img = smooth_image(203, 61, 16);  // a width that is no multiple of any SIMD width
+  const CompressedTransport t = compress_transport(img);
+  const spectral::DisplayTransform display(spectral::DisplayOptions{});
+  const DisplayEncoder8 encoder(display);
+  ASSERT_TRUE(encoder.baked());
+  ASSERT_FALSE(encoder.small_lut(0).empty()) << "the sRGB curve gets the small table";
+  for (const auto& lights : {two_lights(), std::vector<LightSpec>{parse_light_spec("off"), parse_light_spec("F11*3")}}) {
+    RelightOptions o;
+    o.exposure_ev = 0.7;
+    const RelightMatrix m(img.bins, lights, o);
+    std::vector<float> xyz(3 * img.pixel_count());
+    relight_compressed_into(t, m, xyz.data());
+    std::vector<std::uint8_t> ref(xyz.size()), fused(xyz.size()), fused1(xyz.size());
+    encoder.encode(xyz.data(), img.pixel_count(), ref.data());
+    relight_compressed_to_display8(t, m, encoder, fused.data());
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+      relight_compressed_to_display8(t, m, encoder, fused1.data());
+    }
+    EXPECT_EQ(fused, fused1) << "independent of the thread count";
+    std::size_t differ = 0;
+    int worst = 0;
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+      const int d = std::abs(int{ref[i]} - int{fused[i]});
+      worst = std::max(worst, d);
+      differ += d != 0;
+    }
+    EXPECT_LE(worst, 1);
+    EXPECT_LE(differ, ref.size() / 1000) << differ << " of " << ref.size();
+    std::size_t saturated = 0;
+    for (const std::uint8_t v : fused) saturated += v == 255;
+    EXPECT_LT(saturated, fused.size()) << "not all white";
+  }
+}
+
+// prizma-relight compress --compact: the file relights (from its coefficients alone) within the
+// stated bound of the exact relight, for each light alone under each test light.
+TEST(CompressFile, CompactFileRelitWithinTheBound) {
+  const fs::path dir = test::scratch_dir("compress");
+  const auto img = smooth_image(48, 40, 16);
+  spectral::write_spectral_exr(dir / "in.exr", img);
+  CompressFileOptions options;
+  options.compact = true;
+  options.criterion.max_delta_e = 0.5;
+  const CompressedTransport stored = compress_spectral_exr(dir / "in.exr", dir / "compact.exr", options);
+  spectral::ExrReadOptions read;
+  read.read_coefficients = true;
+  read.allow_compact = true;
+  spectral::SpectralImage back = spectral::read_spectral_exr(dir / "compact.exr", read);
+  ASSERT_TRUE(back.compact());
+  for (std::size_t l = 0; l < back.lights.size(); ++l) {
+    EXPECT_EQ(back.lights[l].coefficients.k, stored.lights[l].k);
+    EXPECT_LT(stored.lights[l].k, 16);
+    EXPECT_EQ(back.lights[l].coefficients.errors.size(), 4u);
+  }
+  RelightSession compact(std::move(back), "compact.exr");
+  ASSERT_NE(compact.coefficients(), nullptr);
+  RelightSession exact(img, "in.exr");
+  ASSERT_EQ(exact.coefficients(), nullptr);
+  for (const char* light : {"D65", "A", "F11", "gaussian:450:20"}) {
+    for (std::size_t l = 0; l < 2; ++l) {
+      const std::string other = l == 0 ? "back" : "key";
+      const std::string self = l == 0 ? "key" : "back";
+      for (RelightSession* s : {&compact, &exact}) {
+        s->set_light(self, light);
+        s->set_light(other, "off");
+      }
+      const XyzImage& a = exact.xyz();
+      const XyzImage& b = compact.xyz();
+      const Eigen::Vector3d white = exact.matrix().mix_white_xyz();
+      std::vector<double> de(a.pixel_count());
+      for (std::size_t p = 0; p < de.size(); ++p)
+        de[p] = spectral::delta_e2000(spectral::xyz_to_lab(a.at(static_cast<int>(p % 48), static_cast<int>(p / 48)), white),
+                                      spectral::xyz_to_lab(b.at(static_cast<int>(p % 48), static_cast<int>(p / 48)), white));
+      std::sort(de.begin(), de.end());
+      const double p99 = de[static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(de.size()))) - 1];
+      EXPECT_LE(p99, 0.5 + 1e-3) << self << " under " << light;
+      EXPECT_GT(p99, 0.0) << "the compact file is not the exact one";
+    }
+  }
+  // probe gives the bins the coefficients make.
+  const ProbeResult probe = compact.probe(3, 4);
+  ASSERT_EQ(probe.bins.size(), 2u);
+  ASSERT_EQ(probe.bins[0].size(), 16u);
+  EXPECT_NEAR(probe.bins[0][5], img.lights[0].data[(4 * 48 + 3) * 16 + 5], 0.02);
+  // A compact file cannot be relit exactly; the kept-bins file can.
+  spectral::SpectralImage again = spectral::read_spectral_exr(dir / "compact.exr", read);
+  EXPECT_THROW(RelightSession(std::move(again), "compact.exr", true), spectral::InputError);
+  options.compact = false;
+  compress_spectral_exr(dir / "in.exr", dir / "full.exr", options);
+  RelightSession full_exact(spectral::read_spectral_exr(dir / "full.exr", read), "full.exr", true);
+  EXPECT_EQ(full_exact.coefficients(), nullptr);
+  RelightSession original(img, "in.exr");
+  EXPECT_EQ(full_exact.xyz().xyz, original.xyz().xyz);
+  fs::remove_all(dir);
+}
+
+TEST(CompressFile, RefusesACompactInputABadBoundAndAFluorescentFile) {
+  const fs::path dir = test::scratch_dir("compress-refuse");
+  spectral::write_spectral_exr(dir / "in.exr", smooth_image(16, 8, 8));
+  CompressFileOptions options;
+  options.compact = true;
+  compress_spectral_exr(dir / "in.exr", dir / "compact.exr", options);
+  try {
+    compress_spectral_exr(dir / "compact.exr", dir / "again.exr", options);
+    FAIL();
+  } catch (const spectral::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("compact file"), std::string::npos) << e.what();
+  }
+  options.criterion.max_delta_e = 0.0;
+  EXPECT_THROW(compress_spectral_exr(dir / "in.exr", dir / "zero.exr", options), spectral::InputError);
+  EXPECT_FALSE(fs::exists(dir / "again.exr") || fs::exists(dir / "zero.exr"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "prizma/spectral/bin_layout.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/light_spectrum.h"
+#include "prizma/spectral/spectral_exr.h"
 
 namespace prizma::spectral {
 
@@ -48,13 +49,9 @@ struct BasisCriterion {
   std::size_t max_samples = std::size_t{1} << 18;
 };
 
-// The error of a k-term reconstruction of one layer under one light: ΔE00 between the relit exact
-// and relit reconstructed spectra, CIELAB relative to the light's white (XYZ of T = 1, Y = 1).
-struct BasisError {
-  std::string light;
-  double percentile = 0.0;  // ΔE00 at criterion.percentile
-  double max = 0.0;         // largest ΔE00 over the evaluated pixels
-};
+// The error of a k-term reconstruction of one layer under one light (BasisError, spectral_exr.h):
+// ΔE00 between the relit exact and relit reconstructed spectra, CIELAB relative to the light's white
+// (XYZ of T = 1, Y = 1), at criterion.percentile and the maximum.
 
 struct BasisChoice {
   int k = 0;

@@ -24,6 +24,24 @@ struct SpectralExrInfo {
   bool is_prizma = false;        // read: the file carried prizma: attributes
 };
 
+// How well a layer's k-term spectral-basis reconstruction relights under one test light
+// (spectral_basis.h, choose_basis_size): CIEDE2000 against the exact relight over the pixels.
+struct BasisError {
+  std::string light;
+  double percentile = 0.0;  // ΔE00 at the criterion's percentile (99th by default)
+  double max = 0.0;         // largest ΔE00 over the evaluated pixels
+};
+
+// A light layer's compressed transport (docs/spectral-exr.md, "Spectral-basis coefficients"): k
+// orthonormal basis spectra over the bins and k coefficients per pixel, t_p ≈ Σ_j c(p, j)·b_j.
+// k = 0: the layer has none.
+struct LayerCoefficients {
+  int k = 0;
+  std::vector<float> basis;        // k·bins: basis vector j is basis[j·bins, (j+1)·bins)
+  std::vector<float> values;       // pixel_count·k, pixel-major: c(p, j) = values[p·k + j]
+  std::vector<BasisError> errors;  // measured when k was chosen (empty when unknown)
+};
+
 // One light's transport: width·height·bins floats, pixel-major, bins contiguous:
 // value(x, y, i) = data[(y·width + x)·bins + i].
 struct TransportLayer {
@@ -34,6 +52,9 @@ struct TransportLayer {
   // lists: empty, or pixel_count()·reradiation.size() floats, pixel-major, pairs contiguous
   // (docs/spectral-exr.md, "Bispectral channels"). The diagonal M[i][i] is `data`.
   std::vector<float> reradiation;
+  // Spectral-basis coefficients, read only with ExrReadOptions::read_coefficients and written when
+  // k > 0. In a compact file (SpectralImage::compact()) `data` and `variance` are empty.
+  LayerCoefficients coefficients;
 };
 
 // A bispectral term: light absorbed in bin `in` re-emitted into bin `out` (in ≠ out).
@@ -53,7 +74,14 @@ struct SpectralImage {
   // wavelength-diagonal image (no fluorescence), which is then written exactly as before.
   std::vector<BinPair> reradiation;
 
+  // How the layers' coefficients were chosen (prizma:coefficients "criterion", a JSON object), or empty.
+  std::string coefficient_criterion;
+
   std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
+  // Every layer carries coefficients.
+  bool has_coefficients() const;
+  // Coefficients only, no transport bins (written by prizma-relight compress --compact).
+  bool compact() const;
   // Index of the light with this name, or -1.
   int find_light(std::string_view name) const;
 };
@@ -91,8 +119,14 @@ void write_spectral_exr(const std::filesystem::path& path, const SpectralImage& 
 // prizma:checksum is verified unless opts.verify_checksum is false: a mismatch is InputError "pixel
 // data do not match prizma:checksum", saying when the header shows that another tool re-encoded the
 // file (half, PXR24, B44: the values changed, the attribute was copied).
+//
+// Spectral-basis coefficients (docs/spectral-exr.md): read into TransportLayer::coefficients only
+// with read_coefficients (else their channels are read only to verify the checksum). A compact
+// file (coefficients, no bins) is refused with an InputError that says so unless allow_compact.
 struct ExrReadOptions {
   bool verify_checksum = true;
+  bool read_coefficients = false;
+  bool allow_compact = false;
 };
 SpectralImage read_spectral_exr(const std::filesystem::path& path, const ExrReadOptions& opts = {});
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -38,11 +39,46 @@ struct CompressedTransport {
 CompressedTransport compress_transport(const spectral::SpectralImage& image,
                                        const spectral::BasisCriterion& criterion = {});
 
+// The coefficients a spectral EXR carries (SpectralImage::has_coefficients; read with
+// ExrReadOptions::read_coefficients), moved out of the image's layers (their k, basis and errors stay).
+// Throws InputError (naming `source`) when a layer's sizes disagree.
+CompressedTransport take_coefficients(spectral::SpectralImage& image, const std::string& source);
+
+// Stores `transport` in the image's layers for write_spectral_exr (coefficients, basis, errors and the
+// criterion); with `compact` the transport bins and variance are dropped.
+void store_coefficients(spectral::SpectralImage& image, const CompressedTransport& transport,
+                        const spectral::BasisCriterion& criterion, bool compact);
+
+// The criterion as the JSON object prizma:coefficients records ("criterion").
+std::string criterion_json(const spectral::BasisCriterion& criterion);
+
+// prizma-relight compress: reads `input` (bins required: a compact file is refused, and so is a
+// bispectral one), compresses every layer with `criterion` and writes `output` atomically with the
+// coefficients added (the bins kept unless `compact`). Returns what was stored (per layer k and errors).
+struct CompressFileOptions {
+  bool compact = false;
+  bool verify_checksum = true;
+  spectral::BasisCriterion criterion;
+};
+CompressedTransport compress_spectral_exr(const std::filesystem::path& input, const std::filesystem::path& output,
+                                          const CompressFileOptions& options);
+
 // XYZ = Σ_l (M_l·B_l)·c_l for every pixel (TBB over rows; independent of the thread count). Throws
 // RuntimeError when the matrix does not match the transport's lights or bins, or a layer's sizes
 // are inconsistent.
 void relight_compressed_into(const CompressedTransport& transport, const RelightMatrix& matrix, float* xyz_out);
 XyzImage relight_compressed(const CompressedTransport& transport, const RelightMatrix& matrix);
+
+class DisplayEncoder8;
+
+// One frame from coefficients straight to 8-bit display RGB (3·pixels bytes, interleaved): the
+// display matrix folded into the 3×k weights (A·M_l·B_l), each row relit into a row of linear RGB and
+// encoded through the encoder's small table while it is in cache (TBB over rows, Highway SIMD over
+// pixels). The codes equal encoder.encode(relight_compressed_into(...)) within one (float rounding
+// of the folded matrix), and do not depend on the thread count. Needs a baked encoder with a small
+// table; otherwise it relights to XYZ and calls encode() (same codes, slower).
+void relight_compressed_to_display8(const CompressedTransport& transport, const RelightMatrix& matrix,
+                                    const DisplayEncoder8& encoder, std::uint8_t* rgb_out);
 
 // XYZ → 8-bit display RGB, the values write_output_image writes into an 8-bit PNG (OCIO transform,
 // clamp to [0, 1], round to 255ths), computed fast when the transform is a matrix followed by a
@@ -55,17 +91,29 @@ class DisplayEncoder8 {
  public:
   explicit DisplayEncoder8(const spectral::DisplayTransform& display);
   bool baked() const { return m_baked; }
+  // Baked: the display matrix (XYZ → linear display RGB) and the curve as code thresholds.
+  const Eigen::Matrix3f& matrix() const { return m_matrix; }
+  // The small table (baked curves whose code steps are not too close): code of linear v ≥ 0 is
+  // lut[min(v·lut_scale, size−1)], plus one when v ≥ threshold(code + 1). Empty when not available.
+  const std::vector<std::int32_t>& small_lut(int channel) const { return m_small[static_cast<std::size_t>(channel)]; }
+  float small_lut_scale() const { return m_small_scale; }
+  // thresholds(c)[j]: the smallest linear value with code ≥ j (j = 1..255), [256] = +∞.
+  const float* thresholds(int channel) const { return m_thresholds[static_cast<std::size_t>(channel)].data(); }
   // xyz: 3·pixels floats, interleaved; rgb: 3·pixels bytes. Non-finite values count as 0.
   void encode(const float* xyz, std::size_t pixels, std::uint8_t* rgb) const;
 
  private:
   void encode_chunk(const float* xyz, std::size_t pixels, std::uint8_t* rgb) const;
+  void build_small_lut();
   const spectral::DisplayTransform* m_display;
   bool m_baked = false;
   Eigen::Matrix3f m_matrix = Eigen::Matrix3f::Identity();
-  // Per channel: m_thresholds[c][j] = smallest linear value with code ≥ j (j = 1..255; [0] unused).
-  std::array<std::array<float, 256>, 3> m_thresholds{};
+  // Per channel: m_thresholds[c][j] = smallest linear value with code ≥ j (j = 1..255; [0] unused,
+  // [256] = +∞).
+  std::array<std::array<float, 257>, 3> m_thresholds{};
   std::array<std::vector<std::uint8_t>, 3> m_guess;  // code of the smallest value of each 16-bit bucket
+  std::array<std::vector<std::int32_t>, 3> m_small;  // the small table (small_lut)
+  float m_small_scale = 0.0f;
 };
 
 }  // namespace prizma::relight

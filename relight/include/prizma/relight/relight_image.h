@@ -1,5 +1,8 @@
 #pragma once
 // relight_image: the per-pixel evaluation XYZ = Σ_l M_l · T_l over a whole spectral image.
+#include <string>
+#include <vector>
+
 #include "prizma/relight/relight_matrix.h"
 #include "prizma/relight/xyz_image.h"
 #include "prizma/spectral/spectral_exr.h"
@@ -29,6 +32,16 @@ struct ReradiationTermWeights {
   std::vector<double> weights;  // row-major, 3 × values_per_pixel
 };
 ReradiationTermWeights reradiation_term_weights(const RelightMatrix& matrix, const ReradiationWeights& k, int light);
+
+// The set-up every relight kernel shares (relight_into, relight_compressed_into): checks that `matrix`
+// has `layers` lights of `bins` bins (RuntimeError naming `what`, e.g. "image", otherwise) and returns
+// the lights that are on, each with its 3×n weights as float, row-major (X, Y, Z rows). Lights whose
+// matrix is zero ("off") are left out, so the kernels skip them entirely.
+struct LightWeights {
+  int light = 0;
+  std::vector<float> weights;
+};
+std::vector<LightWeights> light_weights(const RelightMatrix& matrix, int layers, int bins, const std::string& what);
 
 // The same into a caller-owned buffer of 3·width·height floats (reused across interactive relights).
 // For a bispectral image, `k` (for the matrix's observer) is used when given, else computed.

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/light_spec.h"
 #include "prizma/relight/output_image.h"
 #include "prizma/relight/relight_image.h"
@@ -49,11 +50,16 @@ class RelightSession {
   // Reads the spectral EXR (InputError naming the path when it is not one). Lights start at their
   // defaults: the file's prizma:lights spectrum for each layer, else D65.
   explicit RelightSession(const std::filesystem::path& spectral_exr);
-  // Takes an image already in memory; `source` names it in messages and metadata.
-  RelightSession(spectral::SpectralImage image, std::string source);
+  // Takes an image already in memory; `source` names it in messages and metadata. When the image
+  // carries spectral-basis coefficients (read with ExrReadOptions::read_coefficients; a compact file
+  // has nothing else) the session relights from them (relight_compressed_into), unless `exact`, which
+  // relights from the bins and is refused (InputError) for a compact file.
+  RelightSession(spectral::SpectralImage image, std::string source, bool exact = false);
   ~RelightSession();
 
   const spectral::SpectralImage& image() const { return m_image; }
+  // The coefficients relit instead of the bins, or null (docs/relight.md, "Compressed transport").
+  const CompressedTransport* coefficients() const { return m_compressed.get(); }
   const std::string& source() const { return m_source; }
   // Layer names as users type them ("T" for an unnamed single layer).
   const std::vector<std::string>& light_names() const { return m_light_names; }
@@ -108,6 +114,7 @@ class RelightSession {
   spectral::DisplayOptions m_display_options;
   XyzImage m_xyz;
   ReradiationWeights m_reradiation;  // bispectral images: K per observer (relight_image.h)
+  std::unique_ptr<CompressedTransport> m_compressed;
   bool m_dirty = true;
 };
 
