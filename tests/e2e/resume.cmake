@@ -1,14 +1,7 @@
 # Interruptions and --resume (tests/e2e/resume/interrupt-and-resume): SIGINT, SIGTERM and SIGHUP keep
 # the completed passes, a second signal writes nothing, --resume needs only the file and matches the
 # uninterrupted render within the merge tolerance, a changed scene is refused. Label "resume".
-if(NOT TARGET prizma-render)
-  return()
-endif()
-find_program(PRIZMA_SYSTEM_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT PRIZMA_SYSTEM_PYTHON3)
-  message(STATUS "tests/e2e/resume.cmake: /usr/bin/python3 not found, interruption tests skipped")
-  return()
-endif()
+prizma_e2e_require(resume.cmake TARGETS prizma-render PYTHON)
 
 # Compares two renders of the same samples within the merge tolerance (also used by slurm.cmake).
 add_executable(prizma-test-exr-compare ${PRIZMA_E2E_DIR}/resume/exr_compare.cpp)
