@@ -14,3 +14,12 @@ add_test(NAME docs.user-guide COMMAND ${_docs_run} run --doc ${_docs_dir}/user-g
 add_test(NAME docs.metamerism COMMAND ${_docs_run} run --doc ${_docs_dir}/metamerism.md --work ${_docs_work} --data-link)
 set_tests_properties(docs.user-guide docs.metamerism PROPERTIES FIXTURES_REQUIRED docs_installed LABELS docs
                      TIMEOUT 300)
+# scripts/install and scripts/demo themselves, bounded (tests/e2e/docs/run-scripts): this build tree
+# is reused as it is configured (PRIZMA_REUSE_BUILD=1, no apt: PRIZMA_SKIP_SETUP=1), the demo renders
+# 16×16 at 2 samples per pixel. They build in this tree (a no-op when it is built): one at a time.
+get_filename_component(_docs_src ${PRIZMA_E2E_DIR}/../.. ABSOLUTE)
+foreach(script install demo)
+  add_test(NAME docs.scripts-${script}
+           COMMAND ${PRIZMA_E2E_DIR}/docs/run-scripts ${script} ${_docs_src} ${CMAKE_BINARY_DIR} ${_docs_work}/scripts-${script})
+  set_tests_properties(docs.scripts-${script} PROPERTIES LABELS docs TIMEOUT 300 RESOURCE_LOCK build_tree)
+endforeach()
