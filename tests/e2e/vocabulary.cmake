@@ -41,6 +41,16 @@ prizma_relight_e2e(err_jpeg_16bit "scene.exr|--bit-depth|16|-o|err11.jpg" EXPECT
 prizma_relight_e2e(color_space_spelling "scene.exr|--color-space|ACEScg|-o|acescg.exr" MUST_EXIST acescg.exr)
 prizma_relight_e2e(ocio "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-v|-o|ocio.png" MUST_EXIST ocio.png
   STDERR_MATCH "OCIO config ${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio")
+# --ocio with every kind of output that goes through OpenColorIO; refused where nothing would use it.
+prizma_relight_e2e(ocio_tiff "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|--display|Display P3|-o|ocio.tif"
+  MUST_EXIST ocio.tif)
+prizma_relight_e2e(ocio_jpeg "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-o|ocio.jpg" MUST_EXIST ocio.jpg)
+prizma_relight_e2e(ocio_exr_colour_space "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|--colour-space|ACEScg|-o|ocio_cs.exr"
+  MUST_EXIST ocio_cs.exr)
+prizma_relight_e2e(err_ocio_xyz_exr "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-o|err15.exr" EXPECT_RC 2
+  ERR_REGEX "--ocio: an XYZ EXR output is written as it is" MUST_NOT_EXIST err15.exr)
+prizma_render_e2e(err_ocio "${_tiny}|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-o|bad.exr" EXPECT_RC 2
+  MUST_NOT_EXIST bad.exr ERR_LINES 1 ERR_REGEX "^prizma-render: error: --ocio: prizma-render converts nothing through OpenColorIO")
 prizma_relight_e2e(err_ocio_missing "scene.exr|--ocio|nowhere.ocio|-o|err12.png" EXPECT_RC 2
   ERR_REGEX "nowhere\\.ocio" MUST_NOT_EXIST err12.png)
 prizma_relight_e2e(err_display_exr "scene.exr|--display|Display P3|-o|err13.exr" EXPECT_RC 2
