@@ -11,6 +11,8 @@ find_package(nlohmann_json CONFIG REQUIRED)
 
 # OpenImageIO's CMake config on Debian 12 needs OpenCV headers: use pkg-config instead.
 pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
+# Little CMS (liblcms2-dev): the ICC profiles of PNG/TIFF/JPEG outputs, made in the image module.
+pkg_check_modules(LCMS2 REQUIRED IMPORTED_TARGET lcms2)
 # OpenColorIO's config sits where find_package does not look: use pkg-config.
 pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO)
 # prizma-relight -i: line editing and history (libedit-dev), inline images in sixel terminals (libsixel-dev).

@@ -2,14 +2,17 @@
 // libspectral/include/prizma/spectral/image_io.h for why and how it is found).
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <lcms2.h>
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "prizma/spectral/image_io.h"
 
 namespace {
 
+using prizma::spectral::PictureColourSpace;
 using prizma::spectral::PicturePixelType;
 using prizma::spectral::PictureReader;
 using prizma::spectral::PictureSpec;
@@ -48,6 +51,56 @@ class SinkProxy final : public OIIO::Filesystem::IOProxy {
  private:
   mod::ByteSink& m_sink;
 };
+
+// Little CMS's error handler: its message into the std::string that is the context's user data.
+void record_lcms_error(cmsContext ctx, cmsUInt32Number, const char* text) {
+  if (auto* message = static_cast<std::string*>(cmsGetContextUserData(ctx))) *message = text != nullptr ? text : "";
+}
+
+// An RGB matrix/TRC ICC profile (v4) of `cs`, made by Little CMS: the primaries and white as given
+// (stored adapted to the D50 connection space, with the adaptation in the chad tag, as ICC v4
+// requires), one curve for all three channels, the name as the profile description. Empty with
+// `reason` set when Little CMS refuses (e.g. primaries that do not span a space).
+std::vector<unsigned char> icc_profile(const PictureColourSpace& cs, std::string& reason) {
+  std::string lcms_error;
+  cmsContext ctx = cmsCreateContext(nullptr, &lcms_error);
+  if (ctx == nullptr) {
+    reason = "cannot make the ICC profile (out of memory)";
+    return {};
+  }
+  cmsSetLogErrorHandlerTHR(ctx, record_lcms_error);
+  const auto& c = cs.chromaticities;
+  const cmsCIExyY white{c[6], c[7], 1.0};
+  const cmsCIExyYTRIPLE primaries{{c[0], c[1], 1.0}, {c[2], c[3], 1.0}, {c[4], c[5], 1.0}};
+  cmsToneCurve* curve =
+      cs.curve_table.empty()
+          ? cmsBuildParametricToneCurve(ctx, cs.curve_type, cs.curve_parameters.data())
+          : cmsBuildTabulatedToneCurveFloat(ctx, static_cast<cmsUInt32Number>(cs.curve_table.size()), cs.curve_table.data());
+  std::vector<unsigned char> bytes;
+  cmsHPROFILE profile = nullptr;
+  cmsMLU* description = nullptr;
+  if (curve != nullptr) {
+    cmsToneCurve* curves[3] = {curve, curve, curve};
+    profile = cmsCreateRGBProfileTHR(ctx, &white, &primaries, curves);
+  }
+  if (profile != nullptr) description = cmsMLUalloc(ctx, 1);
+  cmsUInt32Number size = 0;
+  if (description != nullptr && cmsMLUsetASCII(description, "en", "US", cs.name.c_str()) &&
+      cmsWriteTag(profile, cmsSigProfileDescriptionTag, description) && cmsSaveProfileToMem(profile, nullptr, &size) &&
+      size > 0) {
+    bytes.resize(size);
+    if (!cmsSaveProfileToMem(profile, bytes.data(), &size)) bytes.clear();
+  }
+  if (description != nullptr) cmsMLUfree(description);
+  if (profile != nullptr) cmsCloseProfile(profile);
+  if (curve != nullptr) cmsFreeToneCurve(curve);
+  cmsDeleteContext(ctx);
+  if (bytes.empty()) {
+    reason = "cannot make the ICC profile of colour space \"" + cs.name + "\"" +
+             (lcms_error.empty() ? std::string() : " (Little CMS: " + lcms_error + ")");
+  }
+  return bytes;
+}
 
 // The last error OpenImageIO holds (the reader's, else the global one), on one line; both are
 // cleared, so that nothing is left for OpenImageIO to print at exit.
@@ -100,6 +153,11 @@ class OiioModule final : public mod::Module {
     for (const auto& [key, value] : ps.attributes) spec.attribute(key, value);
     for (const auto& [key, values] : ps.float_attributes) {
       spec.attribute(key, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, static_cast<int>(values.size())), values.data());
+    }
+    if (ps.colour_space) {
+      const std::vector<unsigned char> icc = icc_profile(*ps.colour_space, reason);
+      if (icc.empty()) return mod::WriteStatus::Failed;
+      spec.attribute("ICCProfile", OIIO::TypeDesc(OIIO::TypeDesc::UINT8, static_cast<int>(icc.size())), icc.data());
     }
     SinkProxy proxy(filename, sink);
     std::unique_ptr<OIIO::ImageOutput> image = OIIO::ImageOutput::create(filename, &proxy);

@@ -294,9 +294,11 @@ int main(int argc, char** argv) {
   app.add_option("--cmf", common.cmf, "observer: 1931, 1964, 2012-2, 2012-10")->capture_default_str();
   app.add_flag("-q,--quiet", common.quiet, "metamer, light: no summary or table on stdout (the CSV is written)");
   app.add_flag("-v,--verbose", common.verbose, "print the observer, bins and data folder used");
-  app.add_option("--threads", common.threads,
-                 "worker threads (0 = all cores; accepted like the other tools: the designs run on one thread)")
-      ->check(CLI::NonNegativeNumber);
+  // Accepted like the other tools' (scripts pass it to every tool) but not offered in --help: the
+  // designs are small serial solves (milliseconds) with nothing to run in parallel.
+  app.add_option("--threads", common.threads, "accepted and ignored: the designs run on one thread")
+      ->check(CLI::NonNegativeNumber)
+      ->group("");
 
   MetamerCommand metamer;
   CLI::App* sub_metamer = app.add_subcommand(

@@ -133,14 +133,18 @@ void save_one_line(relight::RelightSession& session, const std::string& output, 
 }
 
 // An option that nothing of this run would use is refused, not silently ignored: --display when
-// the only output is an EXR (linear: XYZ, or --colour-space), --colour-space when the only output
-// is a display-encoded PNG, TIFF or JPEG. With --batch, -i or --serve either may be used there.
+// the only output is an EXR (linear: XYZ, or --colour-space), --ocio when it is an XYZ EXR (no
+// transform), --colour-space when the only output is a display-encoded PNG, TIFF or JPEG. With --batch, -i or --serve either may be used there.
 void check_options_used(const CliOptions& o) {
   if (o.output.empty() || !o.batch.empty() || o.interactive || o.serve) return;
   const bool exr = relight::output_format_for(o.output) == relight::OutputFormat::Exr;
   if (exr && o.display_given && !o.show) {
     throw InputError("--display", "an EXR output is linear, not display-encoded (XYZ, or --colour-space NAME): "
                                   "--display applies to .png, .tif and .jpg outputs and --show");
+  }
+  if (exr && o.colour_space.empty() && !o.ocio.empty() && !o.show) {
+    throw InputError("--ocio", "an XYZ EXR output is written as it is, through no OpenColorIO config: --ocio applies to "
+                               ".png, .tif and .jpg outputs, EXR outputs with --colour-space, and --show");
   }
   if (!exr && !o.colour_space.empty()) {
     throw InputError("--colour-space", "applies to EXR outputs only (linear); " + o.output +

@@ -63,10 +63,26 @@ std::vector<float> to_display(const XyzImage& image, const spectral::DisplayTran
 
 namespace {
 
+// The CIE xy chromaticities (red, green, blue, white) of the RGB space `xyz_to_rgb` converts XYZ
+// into: the columns of its inverse are the primaries' XYZ, the inverse times (1, 1, 1) the white's.
+// Nothing for a singular matrix or a primary at infinity.
+std::optional<std::array<double, 8>> chromaticities_of(const Eigen::Matrix3d& xyz_to_rgb) {
+  if (!(std::abs(xyz_to_rgb.determinant()) > 1e-12)) return std::nullopt;
+  const Eigen::Matrix3d inv = xyz_to_rgb.inverse();
+  std::array<double, 8> out{};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d xyz = k < 3 ? Eigen::Vector3d(inv.col(k)) : Eigen::Vector3d(inv * Eigen::Vector3d::Ones());
+    const double sum = xyz.sum();
+    if (!(std::abs(sum) > 1e-12)) return std::nullopt;
+    out[static_cast<std::size_t>(2 * k)] = xyz[0] / sum;
+    out[static_cast<std::size_t>(2 * k + 1)] = xyz[1] / sum;
+  }
+  return out;
+}
+
 // The EXR "chromaticities" (red, green, blue, white xy) of an EXR output: XYZ's own for XYZ; for a
 // linear colour space those that take its RGB back to the image's XYZ (the OCIO transform's matrix M,
-// found from the XYZ unit vectors: the columns of M⁻¹ are the primaries' XYZ, M⁻¹·(1, 1, 1) the
-// white's). Nothing for a colour space that is not linear.
+// found from the XYZ unit vectors). Nothing for a colour space that is not linear.
 std::optional<std::array<float, 8>> exr_chromaticities(const OutputOptions& opts) {
   if (opts.display.colour_space.empty()) return std::array<float, 8>{1, 0, 0, 1, 0, 0, 1.0f / 3, 1.0f / 3};
   const spectral::DisplayTransform transform(transform_options(OutputFormat::Exr, opts));
@@ -80,20 +96,85 @@ std::optional<std::array<float, 8>> exr_chromaticities(const OutputOptions& opts
       const double h = half[static_cast<std::size_t>(3 * c + r)];
       if (!(std::abs(2.0 * h - m(r, c)) <= 1e-5 * (1.0 + std::abs(m(r, c))))) return std::nullopt;  // not linear
     }
-  if (!(std::abs(m.determinant()) > 1e-12)) return std::nullopt;
-  const Eigen::Matrix3d inv = m.inverse();
+  const auto xy = chromaticities_of(m);
+  if (!xy) return std::nullopt;
   std::array<float, 8> out{};
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d xyz = k < 3 ? Eigen::Vector3d(inv.col(k)) : Eigen::Vector3d(inv * Eigen::Vector3d::Ones());
-    const double sum = xyz.sum();
-    if (!(std::abs(sum) > 1e-12)) return std::nullopt;
-    out[static_cast<std::size_t>(2 * k)] = static_cast<float>(xyz[0] / sum);
-    out[static_cast<std::size_t>(2 * k + 1)] = static_cast<float>(xyz[1] / sum);
-  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<float>((*xy)[i]);
   return out;
 }
 
 }  // namespace
+
+std::optional<spectral::PictureColourSpace> display_colour_space(const spectral::DisplayTransform& transform,
+                                                                 const std::string& name) {
+  const std::optional<spectral::DisplayMatrixCurve> split = transform.split_matrix_curve();
+  if (!split) return std::nullopt;
+  const auto xy = chromaticities_of(split->matrix);
+  if (!xy) return std::nullopt;
+  spectral::PictureColourSpace cs;
+  cs.name = name;
+  cs.chromaticities = *xy;
+
+  // The curve (linear → encoded), sampled at x = (k/K)³ (dense near black, where an encoding is
+  // steepest), the same on the three channels, increasing from 0 to 1: then inverted into the
+  // decoding table at evenly spaced encoded values.
+  constexpr int kSamples = 16384;
+  std::vector<float> rgb(static_cast<std::size_t>(3 * (kSamples + 1)));
+  std::vector<double> linear(kSamples + 1), encoded(kSamples + 1);
+  for (int k = 0; k <= kSamples; ++k) {
+    const double t = static_cast<double>(k) / kSamples;
+    linear[static_cast<std::size_t>(k)] = t * t * t;
+    for (int c = 0; c < 3; ++c) rgb[static_cast<std::size_t>(3 * k + c)] = static_cast<float>(t * t * t);
+  }
+  split->curve(rgb.data(), kSamples + 1);
+  for (int k = 0; k <= kSamples; ++k) {
+    const float* p = &rgb[static_cast<std::size_t>(3 * k)];
+    if (!(p[0] == p[1] && p[1] == p[2]) || !std::isfinite(p[0])) return std::nullopt;
+    encoded[static_cast<std::size_t>(k)] = p[0];
+    if (k > 0 && !(encoded[static_cast<std::size_t>(k)] >= encoded[static_cast<std::size_t>(k - 1)])) return std::nullopt;
+  }
+  if (!(std::abs(encoded.front()) < 1e-4 && std::abs(encoded.back() - 1.0) < 1e-4)) return std::nullopt;
+  constexpr int kTable = 1024;
+  std::vector<float> decode(kTable);
+  for (int j = 0; j < kTable; ++j) {
+    const double e = static_cast<double>(j) / (kTable - 1);
+    const auto it = std::lower_bound(encoded.begin(), encoded.end(), e);
+    double x = 1.0;
+    if (it == encoded.begin()) {
+      x = 0.0;
+    } else if (it != encoded.end()) {
+      const auto k = static_cast<std::size_t>(it - encoded.begin());
+      const double f = (e - encoded[k - 1]) / std::max(encoded[k] - encoded[k - 1], 1e-300);
+      x = linear[k - 1] + f * (linear[k] - linear[k - 1]);
+    }
+    decode[static_cast<std::size_t>(j)] = static_cast<float>(x);
+  }
+  // A standard curve is written in its exact parametric form (what viewers expect of sRGB, P3 and
+  // BT.1886-style power laws); any other as the table.
+  struct Candidate {
+    int type;
+    std::array<double, 5> params;
+  };
+  const Candidate candidates[] = {{4, {2.4, 1.0 / 1.055, 0.055 / 1.055, 1.0 / 12.92, 0.04045}},
+                                  {1, {2.4, 0, 0, 0, 0}},
+                                  {1, {2.2, 0, 0, 0, 0}}};
+  for (const Candidate& c : candidates) {
+    double worst = 0.0;
+    for (int j = 0; j < kTable; ++j) {
+      const double v = static_cast<double>(j) / (kTable - 1);
+      const double l = c.type == 1 ? std::pow(v, c.params[0])
+                                   : (v >= c.params[4] ? std::pow(c.params[1] * v + c.params[2], c.params[0]) : c.params[3] * v);
+      worst = std::max(worst, std::abs(l - decode[static_cast<std::size_t>(j)]));
+    }
+    if (worst < 2e-4) {
+      cs.curve_type = c.type;
+      cs.curve_parameters = c.params;
+      return cs;
+    }
+  }
+  cs.curve_table = std::move(decode);
+  return cs;
+}
 
 void write_output_image(const fs::path& path, const XyzImage& image, const OutputOptions& opts,
                         const ImageMetadata& metadata) {
@@ -103,9 +184,11 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
 
   // Pixels: linear XYZ / colour space for EXR, display-encoded and clamped to [0, 1] otherwise.
   std::vector<float> pixels;
+  std::optional<spectral::PictureColourSpace> colour_space;
   if (needs_transform(format, opts)) {
     const spectral::DisplayTransform transform(transform_options(format, opts));
     pixels = to_display(image, transform);
+    if (format != OutputFormat::Exr) colour_space = display_colour_space(transform, opts.display.display);
   } else {
     pixels = image.xyz;
     for (float& v : pixels)
@@ -129,12 +212,14 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
     if (const auto chromaticities = exr_chromaticities(opts)) {
       spec.float_attributes.emplace_back("chromaticities", std::vector<float>(chromaticities->begin(), chromaticities->end()));
     }
-  } else if (format == OutputFormat::Png) {
-    // The display it is encoded for (OpenImageIO writes the sRGB chunk for "sRGB"). Not for TIFF:
+  } else {
+    // PNG, TIFF, JPEG: an ICC profile of the display's colour space, when its transform is a matrix
+    // and a per-channel curve (display_colour_space).
+    spec.colour_space = colour_space;
+    // PNG: also the display's name (OpenImageIO writes the sRGB chunk for "sRGB"). Not for TIFF:
     // OpenImageIO 2.4's TIFF writer then leaves a file without its ImageLength field.
-    spec.attributes.emplace_back("oiio:ColorSpace", opts.display.display);
-  } else if (format == OutputFormat::Jpeg) {
-    spec.attributes.emplace_back("Compression", "jpeg:95");
+    if (format == OutputFormat::Png) spec.attributes.emplace_back("oiio:ColorSpace", opts.display.display);
+    if (format == OutputFormat::Jpeg) spec.attributes.emplace_back("Compression", "jpeg:95");
   }
   for (const auto& [key, value] : metadata) spec.attributes.emplace_back(key, value);
 

@@ -76,6 +76,7 @@ struct Options {
   bool half = false;
   std::string preview;
   std::string resume;
+  bool no_verify = false;            // --no-verify: read the --resume file despite its checksum
   std::vector<std::string> defines;  // -D KEY=VALUE, in order
   bool quiet = false;
   bool verbose = false;
@@ -149,13 +150,15 @@ int merge_main(int argc, char** argv) {
   app.set_version_flag("--version", spectral::prizma_version());
   std::vector<std::string> inputs;
   std::string output, preview;
-  bool half = false, quiet = false, verbose = false, strict = false;
+  bool half = false, quiet = false, verbose = false, strict = false, no_verify = false;
   int threads = 0;
   app.add_option("shards", inputs, "shard files (spectral EXR written by prizma-render)")->required();
   app.add_option("-o,--output", output, "merged output file")->required();
   app.add_option("--preview", preview, "also write an sRGB preview (PNG) under the lights' default spectra");
   app.add_flag("--half", half, "write half floats");
   app.add_flag("--strict", strict, "refuse shards that leave a gap in the sample range (exit 2)");
+  app.add_flag("--no-verify", no_verify,
+               "read shards whose pixels do not match prizma:checksum (re-encoded by another tool: docs/spectral-exr.md)");
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
   app.add_flag("-v,--verbose", verbose, "name each shard and its samples as it is read");
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
@@ -165,8 +168,10 @@ int merge_main(int argc, char** argv) {
   return spectral::run_tool(kProgram, [&] {
     check_outputs(output, "-o", preview);
     std::vector<spectral::SpectralImage> shards;
+    spectral::ExrReadOptions read_options;
+    read_options.verify_checksum = !no_verify;
     for (const auto& f : inputs) {
-      shards.push_back(spectral::read_spectral_exr(f));
+      shards.push_back(spectral::read_spectral_exr(f, read_options));
       if (verbose)
         std::cerr << kProgram << ": shard " << f << ": samples " << shards.back().info.sample_range << "\n";
     }
@@ -224,6 +229,9 @@ int main(int argc, char** argv) {
   app.add_option("--resume", o.resume,
                  "continue a partial (interrupted) render from the scene and options it records, up to "
                  "its target or --spp N in all, and merge (output defaults to this file)");
+  app.add_flag("--no-verify", o.no_verify,
+               "with --resume: read the file even when its pixels do not match prizma:checksum (re-encoded by "
+               "another tool: docs/spectral-exr.md)");
   app.add_option("-D", o.defines,
                  "KEY=VALUE: set any scene field by its path, e.g. -D camera.fov_deg=30, "
                  "-D lights.side.spectrum=A, -D materials[1].albedo=0.5 (repeatable; checked like the file)")
@@ -231,9 +239,15 @@ int main(int argc, char** argv) {
       ->type_name("KEY=VALUE");
   app.add_flag("-q,--quiet", o.quiet, "no progress bar or summary");
   app.add_flag("-v,--verbose", o.verbose, "print the scene, mode and statistics");
+  std::string ocio;  // accepted only to be refused with the reason (the tools share their vocabulary)
+  app.add_option("--ocio", ocio, "refused: a render converts nothing through OpenColorIO (give --ocio to prizma-relight)");
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   return spectral::run_tool(kProgram, [&] {
+    if (!ocio.empty()) {
+      throw InputError("--ocio", "prizma-render converts nothing through OpenColorIO (the spectral EXR is not "
+                                 "display-encoded; --preview is sRGB by IEC 61966-2-1): give --ocio CONFIG to prizma-relight");
+    }
     if (o.spp_text) o.spp = render::scene_integer_override(*o.spp_text, "samples", "--spp");
     if (o.width_text) o.width = static_cast<int>(render::scene_integer_override(*o.width_text, "camera.width", "--width"));
     if (o.height_text) o.height = static_cast<int>(render::scene_integer_override(*o.height_text, "camera.height", "--height"));
@@ -264,7 +278,7 @@ int main(int argc, char** argv) {
     if (!o.resume.empty()) {
       if (!defines.empty())
         throw InputError("-D", "not with --resume (the partial file's scene is continued as it was rendered)");
-      render::ResumeRequest req{o.resume, o.scene, given, o.spp};
+      render::ResumeRequest req{o.resume, o.scene, given, o.spp, !o.no_verify};
       render::ResumePlan plan = render::plan_resume(req);
       std::error_code ec;
       if (plan.complete && (o.output.empty() || std::filesystem::equivalent(o.output, o.resume, ec))) {
@@ -284,6 +298,7 @@ int main(int argc, char** argv) {
       recorded = plan.overrides;
       previous = std::move(plan.previous);
     } else {
+      if (o.no_verify) throw InputError("--no-verify", "only with --resume (the one spectral EXR a render reads)");
       if (o.scene.empty()) throw InputError("scene", "no scene file given (or --resume a partial render)");
       scene = spectral::allocating("reading the scene and its volume", [&] { return render::load_scene(o.scene, defines); });
       render::apply_overrides(scene, given);

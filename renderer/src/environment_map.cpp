@@ -10,10 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "checked_picture.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/image_io.h"
-#include "prizma/spectral/input_file.h"
-#include "prizma/spectral/stderr_capture.h"
 
 namespace prizma::render {
 
@@ -79,47 +77,12 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> values,
 
 EnvironmentMap EnvironmentMap::load(const std::filesystem::path& path, double rotation_deg, const std::string& input) {
   const std::string file = path.string();
-  try {
-    spectral::require_regular_file(path, "an environment image");
-  } catch (const InputError& e) {
-    throw InputError(input, std::string("image ") + e.what());
-  }
-  std::error_code ec;
-  const auto file_bytes = static_cast<long long>(std::filesystem::file_size(path, ec));
-  // libpng and OpenEXR may print their errors on stderr first: captured into the one line.
-  // Read through the image module (OpenImageIO, loaded on first use: image_io.h); libpng and
-  // OpenEXR may print their errors on stderr first: captured into the one line.
-  spectral::StderrCapture open_capture;
-  std::string open_error;
-  const std::unique_ptr<spectral::PictureReader> in = spectral::open_picture(file, open_error);
-  const std::string open_printed = open_capture.finish();
-  if (!in) {
-    const std::string& e = open_error;
-    throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("image library", open_printed, e));
-  }
-  const int w = in->width(), h = in->height(), nc = in->channels();
-  if (w < 1 || h < 1 || nc < 1) throw InputError(input, "image " + file + " is empty");
+  CheckedPicture picture = read_picture_checked(
+      path, {"an environment image", "an environment map", "image library", kMaxEnvironmentPixels, kMaxEnvironmentExpansion},
+      input);
+  const int w = picture.width, h = picture.height, nc = picture.channels;
   const long long pixels = static_cast<long long>(w) * h;
-  if (pixels > kMaxEnvironmentPixels) {
-    throw InputError(input, "image " + file + " is " + std::to_string(w) + "×" + std::to_string(h) +
-                                " pixels; an environment map has at most " + std::to_string(kMaxEnvironmentPixels) +
-                                " pixels");
-  }
-  const long long decoded = pixels * nc * static_cast<long long>(in->channel_bytes());
-  if (ec || decoded > kMaxEnvironmentExpansion * std::max(file_bytes, 1LL)) {
-    throw InputError(input, "image " + file + " claims " + std::to_string(w) + "×" + std::to_string(h) + "×" +
-                                std::to_string(nc) + " pixels, more than its " + std::to_string(file_bytes) +
-                                " bytes can hold (truncated or corrupt)");
-  }
-  std::vector<float> all(static_cast<std::size_t>(pixels) * nc);
-  spectral::StderrCapture read_capture;
-  std::string read_error;
-  const bool read_ok = in->read_float(all.data(), read_error);
-  const std::string read_printed = read_capture.finish();
-  if (!read_ok) {
-    const std::string& e = read_error;
-    throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("image library", read_printed, e));
-  }
+  std::vector<float> all = std::move(picture.pixels);
   // The first three channels (R, G, B) or the one channel of a grey image.
   const int channels = std::min(nc, 3);
   std::vector<float> px(static_cast<std::size_t>(pixels) * channels);

@@ -51,6 +51,7 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
   spec.width = image.width;
   spec.height = image.height;
   spec.stored = spectral::PicturePixelType::UInt8;
+  spec.colour_space = spectral::srgb_picture_colour_space();  // an sRGB ICC profile
   spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {
     spectral::write_picture(out, spec, spectral::PicturePixelType::UInt8, rgb8.data());
   });

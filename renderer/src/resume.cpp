@@ -92,7 +92,9 @@ RenderOverrides overrides_from_json(const std::string& text, const std::string& 
 ResumePlan plan_resume(const ResumeRequest& req) {
   const std::string file = req.file.string();
   ResumePlan plan;
-  plan.previous = spectral::read_spectral_exr(req.file);
+  spectral::ExrReadOptions read_options;
+  read_options.verify_checksum = req.verify_checksum;
+  plan.previous = spectral::read_spectral_exr(req.file, read_options);
   const auto& info = plan.previous.info;
   if (!info.is_prizma || info.sample_range.empty())
     throw InputError(file, "has no prizma:sampleRange: not a prizma-render file that can be resumed");

@@ -11,10 +11,8 @@
 #include <memory>
 #include <sstream>
 
+#include "checked_picture.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/image_io.h"
-#include "prizma/spectral/input_file.h"
-#include "prizma/spectral/stderr_capture.h"
 
 namespace prizma::render {
 
@@ -112,48 +110,10 @@ TransferFunction read_transfer_function_image(const std::filesystem::path& image
     throw InputError(input, "wavelength range must be increasing (got [" + num(lambda_lo_nm) + ", " +
                                 num(lambda_hi_nm) + "])");
   }
-  const std::string file = image.string();
-  try {
-    spectral::require_regular_file(image, "a transfer-function image");
-  } catch (const InputError& e) {
-    throw InputError(input, std::string("image ") + e.what());
-  }
-  std::error_code ec;
-  const auto file_bytes = static_cast<long long>(std::filesystem::file_size(image, ec));
-  // libpng prints its errors on stderr before OpenImageIO reports them: captured into the one line.
-  spectral::StderrCapture open_capture;
-  std::string open_error;
-  const std::unique_ptr<spectral::PictureReader> in = spectral::open_picture(file, open_error);
-  const std::string open_printed = open_capture.finish();
-  if (!in) {
-    const std::string& e = open_error;
-    throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("libpng", open_printed, e));
-  }
-  const int w = in->width();
-  const int h = in->height();
-  const int nc = in->channels();
-  if (w < 1 || h < 1) throw InputError(input, "image " + file + " is empty");
-  if (nc < 3) throw InputError(input, "image " + file + " has " + std::to_string(nc) + " channel(s); needs R, G, B");
-  const long long pixels = static_cast<long long>(w) * h;
-  if (pixels > kMaxTfPixels) {
-    throw InputError(input, "image " + file + " is " + std::to_string(w) + "×" + std::to_string(h) +
-                                " pixels; a transfer function has at most " + std::to_string(kMaxTfPixels) + " pixels");
-  }
-  const long long decoded = pixels * nc * static_cast<long long>(in->channel_bytes());
-  if (ec || decoded > kMaxTfExpansion * std::max(file_bytes, 1LL)) {
-    throw InputError(input, "image " + file + " claims " + std::to_string(w) + "×" + std::to_string(h) + "×" +
-                                std::to_string(nc) + " pixels, more than its " + std::to_string(file_bytes) +
-                                " bytes can hold (truncated or corrupt)");
-  }
-  std::vector<float> px(static_cast<std::size_t>(pixels) * nc);
-  spectral::StderrCapture read_capture;
-  std::string read_error;
-  const bool read_ok = in->read_float(px.data(), read_error);
-  const std::string read_printed = read_capture.finish();
-  if (!read_ok) {
-    const std::string& e = read_error;
-    throw InputError(input, "cannot read image " + file + ": " + e + spectral::library_said("libpng", read_printed, e));
-  }
+  const CheckedPicture picture = read_picture_checked(
+      image, {"a transfer-function image", "a transfer function", "libpng", kMaxTfPixels, kMaxTfExpansion, 3}, input);
+  const int w = picture.width, h = picture.height, nc = picture.channels;
+  const std::vector<float>& px = picture.pixels;
 
   // Wavelengths of the pixel centres.
   std::vector<double> lambda(w);

@@ -25,23 +25,40 @@ prizma_progress() {
   fi
 }
 
+# prizma_setup ROOT: scripts/setup (the missing Debian packages), unless PRIZMA_SKIP_SETUP=1 (the
+# packages are known to be there: CI, the docs tests).
+prizma_setup() {
+  if [[ "${PRIZMA_SKIP_SETUP:-0}" == 1 ]]; then
+    echo "  skipped (PRIZMA_SKIP_SETUP=1)" >&2
+    return
+  fi
+  "$1/scripts/setup"
+}
+
 # prizma_build_installed ROOT BUILD: configures BUILD (without the test suites when it is new) and
 # builds the target prizma-installed (the tools, and what else is installed), showing progress. On
-# failure prints the end of the log and exits.
+# failure prints the end of the log and exits. PRIZMA_REUSE_BUILD=1 and a configured BUILD: builds
+# the target in BUILD as it is configured (no scripts/build, which configures again): an already
+# built tree costs seconds.
 prizma_build_installed() {
-  local root="$1" build="$2" args=()
-  mkdir -p "$build"
-  # A new build folder gets no tests (faster); an existing one keeps its settings (scripts/build
-  # would otherwise turn -Werror off in a tree scripts/test built with it, and recompile everything).
-  if [[ -f "$build/CMakeCache.txt" ]]; then
-    grep -q '^PRIZMA_WERROR:BOOL=ON$' "$build/CMakeCache.txt" && export PRIZMA_WERROR=1
-  else
-    args+=(-DPRIZMA_BUILD_TESTS=OFF)
-  fi
+  local root="$1" build="$2"
   local jobs="${PRIZMA_JOBS:-$(nproc)}"
-  echo "  building in $build with $jobs jobs (log: $build/build.log); a first build from nothing takes about 20 minutes on one core" >&2
-  if ! PRIZMA_BUILD_DIR="$build" PRIZMA_BUILD_TARGETS=prizma-installed "$root/scripts/build" "${args[@]}" 2>&1 \
-      | prizma_progress "$build/build.log"; then
+  mkdir -p "$build"
+  local cmd=(env PRIZMA_BUILD_DIR="$build" PRIZMA_BUILD_TARGETS=prizma-installed "$root/scripts/build")
+  if [[ "${PRIZMA_REUSE_BUILD:-0}" == 1 && -f "$build/CMakeCache.txt" ]]; then
+    cmd=(cmake --build "$build" -j "$jobs" --target prizma-installed)
+    echo "  reusing the configured build folder $build (PRIZMA_REUSE_BUILD=1; log: $build/build.log)" >&2
+  else
+    # A new build folder gets no tests (faster); an existing one keeps its settings (scripts/build
+    # would otherwise turn -Werror off in a tree scripts/test built with it, and recompile everything).
+    if [[ -f "$build/CMakeCache.txt" ]]; then
+      grep -q '^PRIZMA_WERROR:BOOL=ON$' "$build/CMakeCache.txt" && export PRIZMA_WERROR=1
+    else
+      cmd+=(-DPRIZMA_BUILD_TESTS=OFF)
+    fi
+    echo "  building in $build with $jobs jobs (log: $build/build.log); a first build from nothing takes about 20 minutes on one core" >&2
+  fi
+  if ! "${cmd[@]}" 2>&1 | prizma_progress "$build/build.log"; then
     echo "prizma: the build failed; the end of $build/build.log:" >&2
     tail -n 40 "$build/build.log" >&2
     exit 1

@@ -2,17 +2,10 @@
 # installs this build tree (cmake --install) and moves it to a scratch HOME's ~/.local; each page's
 # ```sh blocks then run in an empty folder, and tests/e2e/docs/check_docs.py checks what the text
 # says about the results (the images' colours, the ΔE00 of the designs). tests/e2e/docs/run-doc.
-if(NOT TARGET prizma-render OR NOT TARGET prizma-relight OR NOT TARGET prizma-metamer)
-  return()
-endif()
-find_program(PRIZMA_DOCS_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT PRIZMA_DOCS_PYTHON3)
-  message(WARNING "tests/e2e/docs.cmake: /usr/bin/python3 not found, the docs tests are not registered")
-  return()
-endif()
+prizma_e2e_require(docs.cmake TARGETS prizma-render prizma-relight prizma-metamer PYTHON WARNING)
 get_filename_component(_docs_dir ${PRIZMA_E2E_DIR}/../../docs ABSOLUTE)
 set(_docs_work ${PRIZMA_E2E_WORK}/docs)
-set(_docs_run ${PRIZMA_DOCS_PYTHON3} ${PRIZMA_E2E_DIR}/docs/run-doc)
+set(_docs_run ${PRIZMA_SYSTEM_PYTHON3} ${PRIZMA_E2E_DIR}/docs/run-doc)
 
 add_test(NAME docs.install COMMAND ${_docs_run} install --build ${CMAKE_BINARY_DIR} --work ${_docs_work})
 set_tests_properties(docs.install PROPERTIES FIXTURES_SETUP docs_installed LABELS docs TIMEOUT 120
@@ -21,3 +14,12 @@ add_test(NAME docs.user-guide COMMAND ${_docs_run} run --doc ${_docs_dir}/user-g
 add_test(NAME docs.metamerism COMMAND ${_docs_run} run --doc ${_docs_dir}/metamerism.md --work ${_docs_work} --data-link)
 set_tests_properties(docs.user-guide docs.metamerism PROPERTIES FIXTURES_REQUIRED docs_installed LABELS docs
                      TIMEOUT 300)
+# scripts/install and scripts/demo themselves, bounded (tests/e2e/docs/run-scripts): this build tree
+# is reused as it is configured (PRIZMA_REUSE_BUILD=1, no apt: PRIZMA_SKIP_SETUP=1), the demo renders
+# 16×16 at 2 samples per pixel. They build in this tree (a no-op when it is built): one at a time.
+get_filename_component(_docs_src ${PRIZMA_E2E_DIR}/../.. ABSOLUTE)
+foreach(script install demo)
+  add_test(NAME docs.scripts-${script}
+           COMMAND ${PRIZMA_E2E_DIR}/docs/run-scripts ${script} ${_docs_src} ${CMAKE_BINARY_DIR} ${_docs_work}/scripts-${script})
+  set_tests_properties(docs.scripts-${script} PROPERTIES LABELS docs TIMEOUT 300 RESOURCE_LOCK build_tree)
+endforeach()

@@ -5,11 +5,7 @@
 # The bad files are written at test time by tests/e2e/errors/make-fixtures (fixture errors_files).
 set(_errors_work ${PRIZMA_E2E_WORK}/errors)
 set(_errors_dir ${PRIZMA_E2E_DIR}/errors)
-find_program(PRIZMA_SYSTEM_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT PRIZMA_SYSTEM_PYTHON3)
-  message(STATUS "tests/e2e/errors.cmake: /usr/bin/python3 not found, bad-file tests skipped")
-  return()
-endif()
+prizma_e2e_require(errors.cmake PYTHON)
 
 add_test(NAME errors.e2e.fixtures COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/make-fixtures ${_errors_work})
 set_tests_properties(errors.e2e.fixtures PROPERTIES FIXTURES_SETUP errors_files LABELS errors)
@@ -167,13 +163,23 @@ endif()
 # module when it writes (400–500 MB: log4cplus, loaded with it, gives up starting its thread).
 # Not in sanitizer builds: ASan reserves terabytes of address space.
 if(NOT PRIZMA_SANITIZE AND NOT PRIZMA_FUZZ AND TARGET prizma-render AND TARGET prizma-relight)
-  set(_limits 400,420,440,450,460,480,500,550,600,800,1200,2000,4000)
-  add_test(NAME errors.e2e.render_out_of_memory
-           COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-memory-limits --workdir ${_errors_work}
-                   --output mem_render.exr --limits-mb 16,20,24,28,32,40,50,64,100,${_limits} -- $<TARGET_FILE:prizma-render> good.json -q -o mem_render.exr)
-  add_test(NAME errors.e2e.relight_out_of_memory
-           COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-memory-limits --workdir ${_errors_work}
-                   --output mem_relight.png --limits-mb 40,60,100,200,300,${_limits} -- $<TARGET_FILE:prizma-relight> good.exr -o mem_relight.png)
-  set_tests_properties(errors.e2e.render_out_of_memory errors.e2e.relight_out_of_memory PROPERTIES
-                       FIXTURES_REQUIRED errors_files LABELS errors ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+  # One list of limits (MB) for both tools; each runs those from its own floor up.
+  set(_memory_limits_mb 16 20 24 28 32 40 50 60 64 70 80 100 150 200 300 400 420 440 450 460 480 500 550 600 800 1200 2000 4000)
+  # prizma_memory_limits_e2e(NAME FLOOR_MB OUTPUT TOOL ARGS...): TOOL ARGS under every limit ≥ FLOOR_MB.
+  function(prizma_memory_limits_e2e name floor output tool)
+    set(limits "")
+    foreach(mb IN LISTS _memory_limits_mb)
+      if(mb GREATER_EQUAL floor)
+        list(APPEND limits ${mb})
+      endif()
+    endforeach()
+    string(REPLACE ";" "," limits "${limits}")
+    add_test(NAME errors.e2e.${name}
+             COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/check-memory-limits --workdir ${_errors_work}
+                     --output ${output} --limits-mb ${limits} -- $<TARGET_FILE:${tool}> ${ARGN})
+    set_tests_properties(errors.e2e.${name} PROPERTIES FIXTURES_REQUIRED errors_files LABELS errors
+                         ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+  endfunction()
+  prizma_memory_limits_e2e(render_out_of_memory 16 mem_render.exr prizma-render good.json -q -o mem_render.exr)
+  prizma_memory_limits_e2e(relight_out_of_memory 40 mem_relight.png prizma-relight good.exr -o mem_relight.png)
 endif()

@@ -9,21 +9,8 @@ set(_fl_work ${PRIZMA_E2E_WORK}/fluorescence)
 set(_fl_scene ${PRIZMA_SOURCE_DATA_DIR}/scenes/fluorescent_dye.json)
 
 function(prizma_fluorescence_e2e name exe args)
-  set(defs -DEXE=${exe} "-DARGS=${args}" -DWORKDIR=${_fl_work})
-  set(extra ${ARGN})
-  set(props "")
-  while(extra)
-    list(POP_FRONT extra key value)
-    if(key STREQUAL "FIXTURES_SETUP" OR key STREQUAL "FIXTURES_REQUIRED")
-      list(APPEND props ${key} ${value})
-    else()
-      list(APPEND defs "-D${key}=${value}")
-    endif()
-  endwhile()
-  add_test(NAME fluorescence.e2e.${name}
-           COMMAND ${CMAKE_COMMAND} ${defs} -P ${PRIZMA_E2E_DIR}/render/run_and_check.cmake)
-  set_tests_properties(fluorescence.e2e.${name} PROPERTIES ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}"
-                       RESOURCE_LOCK fluorescence_e2e_work ${props})
+  prizma_e2e_run(NAME_PREFIX fluorescence WORKDIR ${_fl_work} LOCK fluorescence_e2e_work NAME ${name}
+                 EXE ${exe} ARGS "${args}" ${ARGN})
 endfunction()
 
 set(_small "--width|16|--height|16|--threads|2|-q")

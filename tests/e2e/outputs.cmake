@@ -3,14 +3,7 @@
 # before any work; links to files keep the link; two outputs in one file, and what can be checked
 # before rendering, are refused at once; write errors on standard output exit 1.
 # tests/e2e/outputs/check-outputs runs each case (ulimit, mkfifo and sockets need a harness).
-if(NOT TARGET prizma-render OR NOT TARGET prizma-relight OR NOT TARGET prizma-metamer)
-  return()
-endif()
-find_program(PRIZMA_SYSTEM_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT PRIZMA_SYSTEM_PYTHON3)
-  message(STATUS "tests/e2e/outputs.cmake: /usr/bin/python3 not found, output tests skipped")
-  return()
-endif()
+prizma_e2e_require(outputs.cmake TARGETS prizma-render prizma-relight prizma-metamer PYTHON)
 
 set(_outputs_work ${PRIZMA_E2E_WORK}/outputs)
 # The failing-system-call library of the io_faults case. Not in sanitizer builds: their runtime

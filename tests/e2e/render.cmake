@@ -7,23 +7,10 @@ endif()
 set(_render_work ${PRIZMA_E2E_WORK}/render)
 set(_tiny ${PRIZMA_E2E_DIR}/render/tiny.json)
 
-# prizma_render_e2e(NAME ARGS [key value]...): one run_and_check.cmake invocation.
+# prizma_render_e2e(NAME ARGS [key value]...): one run_and_check.cmake invocation (prizma_e2e_run).
 function(prizma_render_e2e name args)
-  set(defs -DEXE=$<TARGET_FILE:prizma-render> "-DARGS=${args}" -DWORKDIR=${_render_work})
-  set(extra ${ARGN})
-  set(props "")
-  while(extra)
-    list(POP_FRONT extra key value)
-    if(key STREQUAL "FIXTURES_SETUP" OR key STREQUAL "FIXTURES_REQUIRED")
-      list(APPEND props ${key} ${value})
-    else()
-      list(APPEND defs "-D${key}=${value}")
-    endif()
-  endwhile()
-  add_test(NAME render.e2e.${name}
-           COMMAND ${CMAKE_COMMAND} ${defs} -P ${PRIZMA_E2E_DIR}/render/run_and_check.cmake)
-  set_tests_properties(render.e2e.${name} PROPERTIES ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}"
-                       RESOURCE_LOCK render_e2e_work ${props})
+  prizma_e2e_run(NAME_PREFIX render WORKDIR ${_render_work} LOCK render_e2e_work NAME ${name}
+                 EXE $<TARGET_FILE:prizma-render> ARGS "${args}" ${ARGN})
 endfunction()
 
 prizma_render_e2e(help "--help" OUT_REGEX "--spp.*--samples.*--preview")

@@ -1,14 +1,7 @@
 # Interruptions and --resume (tests/e2e/resume/interrupt-and-resume): SIGINT, SIGTERM and SIGHUP keep
 # the completed passes, a second signal writes nothing, --resume needs only the file and matches the
 # uninterrupted render within the merge tolerance, a changed scene is refused. Label "resume".
-if(NOT TARGET prizma-render)
-  return()
-endif()
-find_program(PRIZMA_SYSTEM_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT PRIZMA_SYSTEM_PYTHON3)
-  message(STATUS "tests/e2e/resume.cmake: /usr/bin/python3 not found, interruption tests skipped")
-  return()
-endif()
+prizma_e2e_require(resume.cmake TARGETS prizma-render PYTHON)
 
 # Compares two renders of the same samples within the merge tolerance (also used by slurm.cmake).
 add_executable(prizma-test-exr-compare ${PRIZMA_E2E_DIR}/resume/exr_compare.cpp)
@@ -46,3 +39,24 @@ prizma_render_e2e(resume_huge_spp "--resume|shard0.exr|--spp|1844674407370955161
   MUST_NOT_EXIST huge.exr ERR_LINES 1
   ERR_REGEX "^prizma-render: error: --spp: must be in \\[1, 1099511627776\\] \\(got 18446744073709551613\\)"
   FIXTURES_REQUIRED render_shards)
+
+# --no-verify on merge and --resume: a shard re-encoded by another tool (oiiotool -d half keeps
+# prizma:checksum but not the values) is refused as "probably re-encoded" without it, read with it;
+# without --resume, --no-verify is refused.
+find_program(PRIZMA_OIIOTOOL oiiotool)
+if(PRIZMA_OIIOTOOL)
+  add_test(NAME render.e2e.no_verify_reencoded_shard
+           COMMAND sh -c "set -e; \"$1\" shard0.exr -d half -o reencoded.exr; rm -f nv_*.exr
+if \"$0\" merge reencoded.exr shard1.exr -o nv_refused.exr 2>nv_err.txt; then exit 1; fi
+grep -q 'probably re-encoded by another tool' nv_err.txt; test ! -e nv_refused.exr
+if \"$0\" \"$2\" --resume reencoded.exr --spp 4 -o nv_refused.exr -q 2>nv_err.txt; then exit 1; fi
+grep -q 'probably re-encoded by another tool' nv_err.txt; test ! -e nv_refused.exr
+\"$0\" merge reencoded.exr shard1.exr -o nv_merged.exr --no-verify 2>nv_err.txt; grep -q 'samples 0:4' nv_err.txt
+\"$0\" \"$2\" --resume reencoded.exr --spp 4 -o nv_resumed.exr --no-verify -q; test -s nv_resumed.exr"
+                   $<TARGET_FILE:prizma-render> ${PRIZMA_OIIOTOOL} ${PRIZMA_E2E_DIR}/render/tiny.json)
+  set_tests_properties(render.e2e.no_verify_reencoded_shard PROPERTIES WORKING_DIRECTORY ${PRIZMA_E2E_WORK}/render
+                       FIXTURES_REQUIRED render_shards RESOURCE_LOCK render_e2e_work LABELS resume
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+endif()
+prizma_render_e2e(no_verify_without_resume "${PRIZMA_E2E_DIR}/render/tiny.json|--no-verify|-o|bad.exr" EXPECT_RC 2
+  MUST_NOT_EXIST bad.exr ERR_LINES 1 ERR_REGEX "^prizma-render: error: --no-verify: only with --resume")

@@ -14,22 +14,23 @@ prizma_render_e2e(define_index "${_tiny}|-D|lights[1].spectrum=D50|-D|materials.
   MUST_EXIST define_index.exr ERR_REGEX "light sky: .*default spectrum D50")
 prizma_render_e2e(define_normalization "${_tiny}|-D|normalization={\"min\": 0, \"max\": 255}|-q|-o|define_norm.exr"
   MUST_EXIST define_norm.exr)
-prizma_render_e2e(define_both_spellings "${_tiny}|-D|normalization=\"auto\"|-D|normalisation=\"auto\"|-o|bad.exr"
-  EXPECT_RC 2 MUST_NOT_EXIST bad.exr ERR_LINES 1 ERR_REGEX "error: -D normalization: give normalisation or normalization")
-prizma_render_e2e(define_range "${_tiny}|-D|camera.ortho_height=-1|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
-  ERR_LINES 1 ERR_REGEX "prizma-render: error: -D camera.ortho_height: must be > 0 \\(got -1\\)")
-prizma_render_e2e(define_type "${_tiny}|-D|camera.width=wide|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
-  ERR_LINES 1 ERR_REGEX "error: -D camera.width: must be an integer \\(got string \"wide\"\\)")
-prizma_render_e2e(define_unknown "${_tiny}|-D|camera.fovdeg=30|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
-  ERR_LINES 1 ERR_REGEX "error: -D camera.fovdeg: unknown field \\(known: type, position")
-prizma_render_e2e(define_no_light "${_tiny}|-D|lights.fill.spectrum=A|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
-  ERR_LINES 1 ERR_REGEX "error: -D lights.fill.spectrum: lights has no element named \"fill\" \\(2 elements: side, sky\\)")
-prizma_render_e2e(define_no_value "${_tiny}|-D|camera.width|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
-  ERR_LINES 1 ERR_REGEX "error: -D camera.width: expected KEY=VALUE")
-prizma_render_e2e(define_twice "${_tiny}|-D|seed=1|-D|seed=2|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
-  ERR_LINES 1 ERR_REGEX "error: -D seed: is given twice")
-prizma_render_e2e(define_resume "${_tiny}|--resume|shard0.exr|-D|seed=1|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
-  ERR_LINES 1 ERR_REGEX "error: -D: not with --resume" FIXTURES_REQUIRED render_shards)
+# A refused -D: exit 2, one error line matching REGEX, no bad.exr.
+function(prizma_define_refused name args regex)
+  prizma_render_e2e(${name} "${_tiny}|${args}|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr ERR_LINES 1
+                    ERR_REGEX "${regex}" ${ARGN})
+endfunction()
+prizma_define_refused(define_both_spellings "-D|normalization=\"auto\"|-D|normalisation=\"auto\""
+  "error: -D normalization: give normalisation or normalization")
+prizma_define_refused(define_range "-D|camera.ortho_height=-1"
+  "prizma-render: error: -D camera.ortho_height: must be > 0 \\(got -1\\)")
+prizma_define_refused(define_type "-D|camera.width=wide" "error: -D camera.width: must be an integer \\(got string \"wide\"\\)")
+prizma_define_refused(define_unknown "-D|camera.fovdeg=30" "error: -D camera.fovdeg: unknown field \\(known: type, position")
+prizma_define_refused(define_no_light "-D|lights.fill.spectrum=A"
+  "error: -D lights.fill.spectrum: lights has no element named \"fill\" \\(2 elements: side, sky\\)")
+prizma_define_refused(define_no_value "-D|camera.width" "error: -D camera.width: expected KEY=VALUE")
+prizma_define_refused(define_twice "-D|seed=1|-D|seed=2" "error: -D seed: is given twice")
+prizma_define_refused(define_resume "--resume|shard0.exr|-D|seed=1" "error: -D: not with --resume"
+  FIXTURES_REQUIRED render_shards)
 prizma_render_e2e(merge_vocabulary "merge|shard0.exr|shard1.exr|-o|merged_v.exr|-v|--threads|1"
   MUST_EXIST merged_v.exr ERR_REGEX "shard shard0.exr: samples 0:2" FIXTURES_REQUIRED render_shards)
 
@@ -40,6 +41,16 @@ prizma_relight_e2e(err_jpeg_16bit "scene.exr|--bit-depth|16|-o|err11.jpg" EXPECT
 prizma_relight_e2e(color_space_spelling "scene.exr|--color-space|ACEScg|-o|acescg.exr" MUST_EXIST acescg.exr)
 prizma_relight_e2e(ocio "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-v|-o|ocio.png" MUST_EXIST ocio.png
   STDERR_MATCH "OCIO config ${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio")
+# --ocio with every kind of output that goes through OpenColorIO; refused where nothing would use it.
+prizma_relight_e2e(ocio_tiff "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|--display|Display P3|-o|ocio.tif"
+  MUST_EXIST ocio.tif)
+prizma_relight_e2e(ocio_jpeg "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-o|ocio.jpg" MUST_EXIST ocio.jpg)
+prizma_relight_e2e(ocio_exr_colour_space "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|--colour-space|ACEScg|-o|ocio_cs.exr"
+  MUST_EXIST ocio_cs.exr)
+prizma_relight_e2e(err_ocio_xyz_exr "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-o|err15.exr" EXPECT_RC 2
+  ERR_REGEX "--ocio: an XYZ EXR output is written as it is" MUST_NOT_EXIST err15.exr)
+prizma_render_e2e(err_ocio "${_tiny}|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-o|bad.exr" EXPECT_RC 2
+  MUST_NOT_EXIST bad.exr ERR_LINES 1 ERR_REGEX "^prizma-render: error: --ocio: prizma-render converts nothing through OpenColorIO")
 prizma_relight_e2e(err_ocio_missing "scene.exr|--ocio|nowhere.ocio|-o|err12.png" EXPECT_RC 2
   ERR_REGEX "nowhere\\.ocio" MUST_NOT_EXIST err12.png)
 prizma_relight_e2e(err_display_exr "scene.exr|--display|Display P3|-o|err13.exr" EXPECT_RC 2

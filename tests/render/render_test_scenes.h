@@ -2,6 +2,7 @@
 // Tiny hand-built scenes for the renderer's tests: a box medium seen by an orthographic camera
 // looking down −z, so every pixel's ray crosses the box along z over its full depth.
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
@@ -11,6 +12,9 @@
 #include "prizma/spectral/spectrum.h"
 
 namespace prizma::render::testing {
+
+inline constexpr double kSe = 3.0;  // tolerance of the statistical tests in standard errors (fixed seeds)
+inline constexpr double kPi = std::numbers::pi;
 
 inline Material make_material(spectral::Spectrum albedo, spectral::Spectrum sigma_t, spectral::Spectrum g) {
   Material m;

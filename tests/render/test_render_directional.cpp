@@ -16,13 +16,7 @@ namespace prizma::render {
 namespace {
 
 using spectral::Spectrum;
-using testing::box_scene;
-using testing::grey_material;
-using testing::make_material;
-using testing::pixel_average;
-
-constexpr double kSe = 3.0;  // tolerance in standard errors (fixed seeds)
-constexpr double kPi = std::numbers::pi;
+using namespace testing;  // render_test_scenes.h: the box scene, materials, pixel averages, kSe, kPi
 
 double hg(double cos_theta, double g) {
   return (1.0 - g * g) / (4.0 * kPi * std::pow(1.0 + g * g - 2.0 * g * cos_theta, 1.5));

@@ -21,13 +21,7 @@ namespace prizma::render {
 namespace {
 
 using spectral::Spectrum;
-using testing::box_scene;
-using testing::grey_material;
-using testing::make_material;
-using testing::pixel_average;
-
-constexpr double kSe = 3.0;  // tolerance in standard errors (fixed seeds)
-constexpr double kPi = std::numbers::pi;
+using namespace testing;  // render_test_scenes.h: the box scene, materials, pixel averages, kSe, kPi
 
 Light point_light(std::string name, Eigen::Vector3d position, double radius = 0.0) {
   Light l;

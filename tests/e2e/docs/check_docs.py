@@ -74,6 +74,15 @@ def user_guide(run, out):
         claim(lit.mean() > 0.1 and np.percentile(rgb.max(axis=2), 99) > 0.4,
               "%s not flat or dim: %.0f %% of pixels lit, 99th percentile %.2f" %
               (name, 100 * lit.mean(), np.percentile(rgb.max(axis=2), 99)))
+    # p3.png is tagged as Display P3: an ICC profile, not side.png's sRGB one (relight.md).
+    profiles = {}
+    for name in ("side.png", "p3.png"):
+        _, spec = pixels(os.path.join(tour, name))
+        icc = spec.getattribute("ICCProfile")
+        profiles[name] = bytes(bytearray(icc)) if icc is not None else b""
+    claim(len(profiles["p3.png"]) > 128 and profiles["p3.png"][36:40] == b"acsp" and
+          profiles["p3.png"] != profiles["side.png"] and len(profiles["side.png"]) > 128,
+          "p3.png carries an ICC profile (%d bytes) that is not side.png's sRGB one" % len(profiles["p3.png"]))
     with open(os.path.join(tour, "mixed.jpg"), "rb") as f:
         claim(f.read(3) == b"\xff\xd8\xff", "mixed.jpg is a JPEG")
     _, spec = pixels(os.path.join(tour, "side.exr"))

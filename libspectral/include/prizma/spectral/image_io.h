@@ -9,9 +9,11 @@
 // _prizma.so), <prefix>/lib/prizma/ of the installed tree (installed_prefix.h), the build tree's path.
 // A module that cannot be loaded is a RuntimeError ("cannot load the image module <path>: <why>";
 // "out of memory loading the image module …" when the address space ran out), exit 1.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +24,23 @@ class AtomicOutput;
 
 enum class PicturePixelType { UInt8, UInt16, Float };
 
+// The colour space a display-encoded picture (PNG, TIFF, JPEG) is encoded in, written into it as an
+// ICC profile (an RGB matrix/TRC profile made by Little CMS in the image module). The transfer
+// function maps an encoded value V in [0, 1] to linear light L: ICC parametric curve `curve_type`
+// (1: L = V^g; 4: L = (aV + b)^g for V ≥ d, L = cV below — the sRGB form) with `curve_parameters`
+// {g, a, b, c, d}, or, when `curve_table` is not empty, L sampled at V = i / (n − 1).
+struct PictureColourSpace {
+  std::string name;                        // the profile's description, e.g. "Display P3"
+  std::array<double, 8> chromaticities{};  // CIE 1931 xy of red, green, blue and white
+  int curve_type = 4;
+  std::array<double, 5> curve_parameters{2.4, 1.0 / 1.055, 0.055 / 1.055, 1.0 / 12.92, 0.04045};
+  std::vector<float> curve_table;
+};
+
+// sRGB as IEC 61966-2-1 defines it (Rec. 709 primaries, D65, the piecewise curve): the colour space
+// of pictures encoded without OpenColorIO (prizma-render --preview).
+PictureColourSpace srgb_picture_colour_space();
+
 struct PictureSpec {
   int width = 0;
   int height = 0;
@@ -30,6 +49,7 @@ struct PictureSpec {
   std::vector<std::string> channel_names;                       // empty: OpenImageIO's default (R, G, B, …)
   std::vector<std::pair<std::string, std::string>> attributes;  // string metadata, e.g. {"compression", "zip"}
   std::vector<std::pair<std::string, std::vector<float>>> float_attributes;  // e.g. {"chromaticities", 8 floats}
+  std::optional<PictureColourSpace> colour_space;  // PNG, TIFF, JPEG: embedded as an ICC profile
 };
 
 // Writes one picture into `out` (write_atomically's checked temporary), the format chosen by
@@ -65,7 +85,7 @@ namespace image_io_module {
 
 // What the module exports: extern "C" const Module* prizma_image_io_module_v1(). Compiled with
 // the same compiler and library as the tools (it is built with them), so C++ types cross.
-constexpr int kAbiVersion = 2;  // 2: PictureSpec::float_attributes
+constexpr int kAbiVersion = 3;  // 2: PictureSpec::float_attributes; 3: PictureSpec::colour_space
 constexpr const char* kEntryPoint = "prizma_image_io_module_v1";
 
 // The bytes of the file being written (an AtomicOutput, adapted by the tool's side). Never throws.
@@ -88,7 +108,8 @@ class Module {
  public:
   virtual int abi_version() const = 0;
   virtual bool can_write(const std::string& filename, std::string& reason) const = 0;
-  // Failed: `reason` is the writer's message, or `what` failed when it gave none; UnknownFormat:
+  // Failed: `reason` is the writer's message (or Little CMS's, when the ICC profile of
+  // spec.colour_space cannot be made), or `what` failed when it gave none; UnknownFormat:
   // OpenImageIO's message.
   virtual WriteStatus write(ByteSink& sink, const std::string& filename, const PictureSpec& spec,
                             PicturePixelType given, const void* pixels, std::string& reason) const = 0;

@@ -6,12 +6,14 @@
 //   .exr          linear float, no display transform: XYZ (channels X, Y, Z), or a linear colour
 //                 space of the OCIO config (channels R, G, B) when colour_space is set
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "prizma/relight/xyz_image.h"
 #include "prizma/spectral/display.h"
+#include "prizma/spectral/image_io.h"
 
 namespace prizma::relight {
 
@@ -44,6 +46,15 @@ spectral::DisplayOptions transform_options(OutputFormat format, const OutputOpti
 // Checks the options a format needs (builds the transform once); throws InputError when the config,
 // display or colour space does not exist, or the bit depth is not 8 or 16.
 void check_output_options(OutputFormat format, const OutputOptions& opts);
+
+// The colour space a display transform encodes into, for the ICC profile of PNG/TIFF/JPEG outputs,
+// found from the OCIO transform itself (DisplayTransform::split_matrix_curve): the primaries and
+// white from its XYZ → linear RGB matrix, the decoding curve by inverting its per-channel curve,
+// written as the standard parametric curve it matches (the sRGB piecewise curve, a 2.4 or 2.2
+// power; within 2e-4) or else as a 1024-entry table. Nothing when the transform is not a matrix
+// followed by one increasing curve for all channels from 0 to 1 (e.g. a 3D LUT display).
+std::optional<spectral::PictureColourSpace> display_colour_space(const spectral::DisplayTransform& transform,
+                                                                 const std::string& name);
 
 // Writes the image (display transform for PNG/TIFF; for EXR only when colour_space is set).
 // Written atomically; throws InputError for bad paths or options, RuntimeError (naming the path and

@@ -46,6 +46,7 @@ struct ResumeRequest {
   std::filesystem::path scene;  // the scene given on the command line; empty: the file's prizma:scenePath
   RenderOverrides given;        // options given with --resume (samples from --samples, refused)
   std::optional<std::int64_t> spp;  // --spp N: the total number of samples, from the file's first one
+  bool verify_checksum = true;      // false: --no-verify (a file another tool re-encoded; docs/spectral-exr.md)
 };
 
 struct ResumePlan {
