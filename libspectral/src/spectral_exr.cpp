@@ -100,6 +100,28 @@ int io_threads() {
   return count;
 }
 
+// Pixel data of at most this many bytes (all channels, as stored) are written uncompressed, larger
+// images with PIZ (docs/spectral-exr.md, "Compression"). PIZ encodes 15–30 MB of floats per CPU
+// second (a 24×24, 35-channel image: 5–7 ms, more than rendering it at 1 spp) and saved nothing on
+// such renders (bench_peer.json at 1–256 spp: 81.96 KB PIZ, 82.33 KB uncompressed); below 1 MiB
+// the most any compression could save is a few hundred KB.
+constexpr std::size_t kUncompressedMaxBytes = std::size_t{1} << 20;
+
+std::size_t stored_pixel_bytes(const Imf::Header& h) {
+  const Imath::Box2i dw = h.dataWindow();
+  const auto pixels = static_cast<std::size_t>(std::max(0, dw.max.x - dw.min.x + 1)) *
+                      static_cast<std::size_t>(std::max(0, dw.max.y - dw.min.y + 1));
+  std::size_t per_pixel = 0;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it)
+    per_pixel += it.channel().type == Imf::HALF ? sizeof(half) : sizeof(float);
+  return pixels * per_pixel;
+}
+
+// The compression Prizma writes for a file of this header's size and channels.
+Imf::Compression prizma_compression(const Imf::Header& h) {
+  return stored_pixel_bytes(h) <= kUncompressedMaxBytes ? Imf::NO_COMPRESSION : Imf::PIZ_COMPRESSION;
+}
+
 bool valid_light_name(std::string_view name) {
   if (name.empty()) return false;
   return std::all_of(name.begin(), name.end(), [](char c) {
@@ -501,9 +523,6 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
 
   // Header: channels and attributes.
   Imf::Header header(image.width, image.height);
-  // PIZ (lossless wavelet + Huffman): on noisy Monte Carlo float data it gave files ~25 % smaller than
-  // ZIP and wrote about twice as fast (512×512×32 floats: PIZ 23.7 MB, ZIP 31.4 MB, none 33.6 MB).
-  header.compression() = Imf::PIZ_COMPRESSION;
   const Imf::PixelType type = half_out ? Imf::HALF : Imf::FLOAT;
   for (const auto& layer : layers) {
     for (int i = 0; i < bins; ++i) header.channels().insert(layer.prefix + suffixes[i], Imf::Channel(type));
@@ -575,12 +594,19 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
     }
   }
 
+  // Compression, now that every channel is in the header: none for a small image, else PIZ (lossless
+  // wavelet + Huffman: on noisy Monte Carlo float data it gave files ~25 % smaller than ZIP and wrote
+  // about twice as fast; 512×512×32 floats: PIZ 23.7 MB, ZIP 31.4 MB, none 33.6 MB).
+  header.compression() = prizma_compression(header);
+  const bool compressed = header.compression() != Imf::NO_COMPRESSION;
+
   write_atomically(path, [&](AtomicOutput& out) {
     try {
       AtomicOStream stream(out);
       // OpenEXR's thread count: 0 encodes in this thread, n ≥ 1 keeps n chunks in flight on its pool.
-      const int pool = io_threads();
-      const int in_flight = opts.threads == 1 ? 0 : opts.threads > 1 ? std::min(opts.threads, pool) : pool;
+      // Uncompressed chunks are only copied: no pool (starting its threads costs more than they save).
+      int in_flight = 0;
+      if (compressed && opts.threads != 1) in_flight = opts.threads > 1 ? std::min(opts.threads, io_threads()) : io_threads();
       Imf::OutputFile file(stream, header, in_flight);
       file.setFrameBuffer(fb);
       file.writePixels(image.height);
@@ -786,7 +812,10 @@ void add_slices(Imf::FrameBuffer& fb, const LayerChannels& layer, std::vector<fl
 std::string reencoding_signs(const Imf::Header& h) {
   std::vector<std::string> signs;
   const Imf::Compression c = h.compression();
-  if (c != Imf::PIZ_COMPRESSION) {
+  // Prizma writes small images uncompressed and larger ones with PIZ (earlier versions: PIZ at every
+  // size, so PIZ is no sign).
+  const bool small = prizma_compression(h) == Imf::NO_COMPRESSION;
+  if (c != Imf::PIZ_COMPRESSION && (c != Imf::NO_COMPRESSION || !small)) {
     static const std::map<Imf::Compression, std::pair<const char*, bool>> kNames = {
         {Imf::NO_COMPRESSION, {"none", false}},  {Imf::RLE_COMPRESSION, {"RLE", false}},
         {Imf::ZIPS_COMPRESSION, {"ZIPS", false}}, {Imf::ZIP_COMPRESSION, {"ZIP", false}},
@@ -796,7 +825,8 @@ std::string reencoding_signs(const Imf::Header& h) {
     const auto it = kNames.find(c);
     const std::string name = it == kNames.end() ? "unknown" : it->second.first;
     const bool lossy = it != kNames.end() && it->second.second;
-    signs.push_back(std::string("its compression is ") + (lossy ? "the lossy " : "") + name + ", Prizma writes PIZ");
+    signs.push_back(std::string("its compression is ") + (lossy ? "the lossy " : "") + name +
+                    (small ? ", Prizma writes an image this small uncompressed" : ", Prizma writes PIZ"));
   }
   bool any_half = false, any_float = false;
   for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {

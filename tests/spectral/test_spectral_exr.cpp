@@ -16,6 +16,7 @@
 #include <ImfPreviewImage.h>
 #include <ImfStringAttribute.h>
 #include <ImfStringVectorAttribute.h>
+#include <ImfThreading.h>
 #include <half.h>
 
 #include <algorithm>
@@ -259,9 +260,10 @@ TEST_F(SpectralExr, ThreeLightsWithVarianceRoundTrip) {
 }
 
 // ExrWriteOptions::threads: encoded in the calling thread (1), or with 2 or all of OpenEXR's pool in
-// flight, the file is the same byte for byte (several 32-line PIZ chunks, half and float).
+// flight, the file is the same byte for byte (several 32-line PIZ chunks, half and float: 43 channels
+// of 37×400 pixels, 2.5 and 1.3 MB, above the 1 MiB that is written uncompressed).
 TEST_F(SpectralExr, ThreadCountDoesNotChangeAByte) {
-  const SpectralImage img = make_image(37, 150, BinLayout::linear(400, 700, 8), {"key", "fill"}, true);
+  const SpectralImage img = make_image(37, 400, BinLayout::linear(400, 700, 8), {"key", "fill"}, true);
   auto bytes = [](const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -277,6 +279,7 @@ TEST_F(SpectralExr, ThreadCountDoesNotChangeAByte) {
       files.push_back(bytes(p));
     }
     ASSERT_GT(files[0].size(), 100000u);
+    EXPECT_EQ(Imf::InputFile(file("threads_1.exr").c_str()).header().compression(), Imf::PIZ_COMPRESSION);
     EXPECT_TRUE(files[0] == files[1]);
     EXPECT_TRUE(files[0] == files[2]);
   }
@@ -652,7 +655,8 @@ TEST_F(SpectralExr, ReencodedFileIsNamedAsSuchAndReadsWithoutVerification) {
   });
   const std::string err = read_error(half_pxr24);
   EXPECT_NE(err.find("pixel data do not match prizma:checksum: the file was probably re-encoded by another tool "
-                     "(its compression is the lossy PXR24, Prizma writes PIZ; it was written by OpenImageIO 2.4.7.1)"),
+                     "(its compression is the lossy PXR24, Prizma writes an image this small uncompressed; it "
+                     "was written by OpenImageIO 2.4.7.1)"),
             std::string::npos)
       << err;
   EXPECT_NE(err.find("--no-verify"), std::string::npos) << err;
@@ -669,7 +673,9 @@ TEST_F(SpectralExr, ReencodedFileIsNamedAsSuchAndReadsWithoutVerification) {
       file("zip-edited.exr"), [](const std::string& name, std::vector<float>& v) {
         if (name == "key.T.437,500000nm") v[0] *= 0.5f;
       });
-  EXPECT_NE(read_error(zip).find("(its compression is ZIP, Prizma writes PIZ)"), std::string::npos) << read_error(zip);
+  EXPECT_NE(read_error(zip).find("(its compression is ZIP, Prizma writes an image this small uncompressed)"),
+            std::string::npos)
+      << read_error(zip);
 }
 
 TEST_F(SpectralExr, WritesTheDefaultRelightAsLinearSrgbPreview) {
@@ -888,4 +894,40 @@ TEST_F(SpectralExr, RefusesDeeplyNestedLightsJson) {
   write_spectral_exr(p, img);
   const std::string err = read_error(p);
   EXPECT_NE(err.find("prizma:lights: JSON nested deeper than"), std::string::npos) << err;
+}
+
+// Compression (docs/spectral-exr.md): at most 1 MiB of pixel data (all channels as stored) is
+// written uncompressed, in the calling thread (OpenEXR's pool is not started for it); one byte more,
+// PIZ. Both read back exactly. One light, 13 bins and R, G, B: 16 floats, 64 bytes per pixel.
+TEST_F(SpectralExr, SmallImagesAreWrittenUncompressedLargerOnesWithPiz) {
+  const BinLayout bins = BinLayout::linear(400, 700, 13);
+  const int pool_before = Imf::globalThreadCount();
+  const SpectralImage small = make_image(128, 128, bins, {"a"});  // 128·128·64 bytes = 1 MiB exactly
+  const fs::path ps = file("small.exr");
+  write_spectral_exr(ps, small);
+  EXPECT_EQ(Imf::globalThreadCount(), pool_before);
+  const SpectralImage large = make_image(128, 129, bins, {"a"});
+  const fs::path pl = file("large.exr");
+  write_spectral_exr(pl, large);
+  EXPECT_EQ(Imf::InputFile(ps.c_str()).header().compression(), Imf::NO_COMPRESSION);
+  EXPECT_EQ(Imf::InputFile(pl.c_str()).header().compression(), Imf::PIZ_COMPRESSION);
+  EXPECT_EQ(read_spectral_exr(ps).lights[0].data, small.lights[0].data);
+  EXPECT_EQ(read_spectral_exr(pl).lights[0].data, large.lights[0].data);
+  // A half file counts its bytes as stored: 128×256 pixels of 16 halves, 1 MiB, uncompressed.
+  ExrWriteOptions half_opts;
+  half_opts.pixel_type = ExrPixelType::Half;
+  const fs::path ph = file("small_half.exr");
+  write_spectral_exr(ph, make_image(128, 256, bins, {"a"}), half_opts);
+  EXPECT_EQ(Imf::InputFile(ph.c_str()).header().compression(), Imf::NO_COMPRESSION);
+  // A damaged re-encoding of the large file names what Prizma writes at its size: PIZ, so an
+  // uncompressed copy is a sign too (for the small file it is not: ReencodedFileIsNamed… above).
+  for (const auto& [compression, sign] : {std::pair{Imf::ZIP_COMPRESSION, "(its compression is ZIP, Prizma writes PIZ)"},
+                                          std::pair{Imf::NO_COMPRESSION, "(its compression is none, Prizma writes PIZ)"}}) {
+    const fs::path copy = rewrite_pixels(
+        rewrite_header(pl, file("large-copy.exr"), [c = compression](Imf::Header& h) { h.compression() = c; }),
+        file("large-edited.exr"), [](const std::string& name, std::vector<float>& v) {
+          if (name == "T.411,538462nm") v[0] *= 0.5f;
+        });
+    EXPECT_NE(read_error(copy).find(sign), std::string::npos) << read_error(copy);
+  }
 }
