@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -224,23 +225,35 @@ Medium build_medium(const Volume& vol, const TransferFunction& tf, const std::st
     m.bounds_max[a] = 0.5 * extent[a] / largest;
   }
 
-  // Per voxel: first matching rule.
+  // Per voxel: first matching rule. A voxel with its predecessor's value takes its result (label and
+  // segmented volumes are runs of a few values; the rules and the density ramp need not run again).
   m.material.assign(count, Medium::kEmpty);
   m.density.assign(count, 0.0f);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    float last_value = std::numeric_limits<float>::quiet_NaN();  // equal to no value
+    std::uint16_t last_material = Medium::kEmpty;
+    float last_density = 0.0f;
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const double v = vol.values[i];
-      if (!std::isfinite(v)) continue;
-      for (const MaterialRule& rule : tf.rules) {
-        if (v >= rule.value_lo && v <= rule.value_hi) {
-          const double d = rule.density.eval(v);
-          if (d > 0.0) {
-            m.material[i] = static_cast<std::uint16_t>(rule.material);
-            m.density[i] = static_cast<float>(d);
+      const float value = vol.values[i];
+      if (value != last_value) {
+        last_value = value;
+        last_material = Medium::kEmpty;
+        last_density = 0.0f;
+        const double v = value;
+        if (!std::isfinite(v)) continue;
+        for (const MaterialRule& rule : tf.rules) {
+          if (v >= rule.value_lo && v <= rule.value_hi) {
+            const double d = rule.density.eval(v);
+            if (d > 0.0) {
+              last_material = static_cast<std::uint16_t>(rule.material);
+              last_density = static_cast<float>(d);
+            }
+            break;
           }
-          break;
         }
       }
+      m.material[i] = last_material;
+      m.density[i] = last_density;
     }
   });
   return m;
