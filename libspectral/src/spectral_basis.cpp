@@ -155,6 +155,32 @@ std::vector<BasisError> basis_errors(const SpectralBasis& basis, int k, const fl
   return errors_at(basis, k, data, n, samples, lights, criterion.percentile);
 }
 
+std::vector<BasisError> reconstruction_errors(const Eigen::MatrixXf& basis, const float* coefficients, const float* data,
+                                              std::size_t pixels, const BinLayout& bins, const BasisCriterion& criterion) {
+  const int n = static_cast<int>(basis.rows());
+  const int k = static_cast<int>(basis.cols());
+  if (n != bins.size() || k < 1 || k > n) {
+    throw InputError("spectral basis", std::to_string(n) + "×" + std::to_string(k) + " basis for " +
+                                           std::to_string(bins.size()) + " bins");
+  }
+  const auto samples = sample_pixels(pixels, criterion.max_samples);
+  const auto lights = prepare_lights(data, n, samples, bins, criterion);
+  const Eigen::MatrixXd b = basis.cast<double>();
+  std::vector<BasisError> out;
+  std::vector<double> de(samples.size());
+  for (const TestLight& light : lights) {
+    const Eigen::Matrix<double, 3, Eigen::Dynamic> w = light.weights * b;
+    double worst = 0.0;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const Eigen::Map<const Eigen::VectorXf> c(coefficients + samples[i] * static_cast<std::size_t>(k), k);
+      de[i] = delta_e2000(light.exact_lab[i], xyz_to_lab(w * c.cast<double>(), light.white));
+      worst = std::max(worst, de[i]);
+    }
+    out.push_back({light.name, percentile_of(de, criterion.percentile), worst});
+  }
+  return out;
+}
+
 BasisChoice choose_basis_size(const SpectralBasis& basis, const float* data, std::size_t pixels,
                               const BinLayout& bins, const BasisCriterion& criterion) {
   const int n = basis.bins();
