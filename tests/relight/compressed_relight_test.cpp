@@ -41,6 +41,21 @@ spectral::SpectralImage smooth_image(int width, int height, int bins) {
 
 std::vector<LightSpec> two_lights() { return {parse_light_spec("D65"), parse_light_spec("A*0.7")}; }
 
+// How two 8-bit images differ: the values that differ and the largest difference.
+struct CodeDiff {
+  std::size_t differ = 0;
+  int worst = 0;
+};
+CodeDiff code_diff(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
+  CodeDiff out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const int d = std::abs(int{a[i]} - int{b[i]});
+    out.worst = std::max(out.worst, d);
+    out.differ += d != 0;
+  }
+  return out;
+}
+
 double max_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
   double d = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, double(std::abs(a[i] - b[i])));
@@ -181,13 +196,7 @@ TEST(DisplayEncoder8, BakedSrgbWritesWhatAnEightBitPngHolds) {
   std::vector<std::uint8_t> png(fast.size());
   ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, png.data()));
   in->close();
-  std::size_t differ = 0;
-  int worst = 0;
-  for (std::size_t i = 0; i < png.size(); ++i) {
-    const int d = std::abs(int{png[i]} - int{fast[i]});
-    worst = std::max(worst, d);
-    differ += d != 0;
-  }
+  const auto [differ, worst] = code_diff(png, fast);
   EXPECT_LE(worst, 1);
   EXPECT_LE(differ, png.size() / 1000) << differ << " of " << png.size() << " values differ by 1";
   fs::remove_all(dir);
@@ -246,13 +255,7 @@ TEST(DisplayEncoder8, FusedFrameEqualsRelightThenEncode) {
       relight_compressed_to_display8(t, m, encoder, fused1.data());
     }
     EXPECT_EQ(fused, fused1) << "independent of the thread count";
-    std::size_t differ = 0;
-    int worst = 0;
-    for (std::size_t i = 0; i < ref.size(); ++i) {
-      const int d = std::abs(int{ref[i]} - int{fused[i]});
-      worst = std::max(worst, d);
-      differ += d != 0;
-    }
+    const auto [differ, worst] = code_diff(ref, fused);
     EXPECT_LE(worst, 1);
     EXPECT_LE(differ, ref.size() / 1000) << differ << " of " << ref.size();
     std::size_t saturated = 0;
@@ -300,13 +303,7 @@ TEST(DisplayEncoder8, FusedFrameOnEverySimdTargetAndEveryK) {
       hwy::SetSupportedTargetsForTest(target);
       std::fill(fused.begin(), fused.end(), std::uint8_t{0});
       relight_compressed_to_display8(t, m, encoder, fused.data());
-      std::size_t differ = 0;
-      int worst = 0;
-      for (std::size_t i = 0; i < ref.size(); ++i) {
-        const int d = std::abs(int{ref[i]} - int{fused[i]});
-        worst = std::max(worst, d);
-        differ += d != 0;
-      }
+      const auto [differ, worst] = code_diff(ref, fused);
       EXPECT_LE(worst, 1) << "k = " << k << " on " << hwy::TargetName(target);
       EXPECT_LE(differ, ref.size() / 1000) << "k = " << k << " on " << hwy::TargetName(target) << ": " << differ;
     }
