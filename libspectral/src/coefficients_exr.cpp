@@ -5,6 +5,7 @@
 #include <ImfChannelList.h>
 #include <ImfFloatVectorAttribute.h>
 #include <ImfStringAttribute.h>
+#include <half.h>
 
 #include <algorithm>
 #include <cmath>
@@ -49,6 +50,30 @@ std::uint64_t hash_floats(const float* v, std::size_t n, std::uint64_t h) {
   return h;
 }
 
+// The same for half values as a reader gets them (each converted to float).
+std::uint64_t hash_halves(const half* v, std::size_t n, std::uint64_t h) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float f = v[i];
+    std::uint32_t bits;
+    std::memcpy(&bits, &f, sizeof bits);
+    h = (h ^ bits) * kFnvPrime;
+  }
+  return h;
+}
+
+// Refuses coefficients that half cannot hold (|v| rounds past 65504).
+void check_half_range(const std::vector<float>& v, std::size_t k, std::size_t width, const std::string& what,
+                      const std::string& path) {
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(static_cast<float>(half(v[i])))) {
+      const std::size_t p = i / k;
+      throw InputError(path, what + ": " + std::to_string(v[i]) + " at pixel (" + std::to_string(p % width) + ", " +
+                                 std::to_string(p / width) + "), coefficient " + std::to_string(i % k) +
+                                 " is beyond half's range (65504); scale it into the basis (prizma-relight compress does)");
+    }
+  }
+}
+
 std::string channel_name(const std::string& prefix, int j) { return prefix + "coef." + std::to_string(j); }
 
 void check_finite(const std::vector<float>& v, const std::string& what, const std::string& path) {
@@ -72,7 +97,8 @@ bool parse_coefficient_channel(const std::string& name, CoefficientChannel& out)
 }
 
 std::uint64_t add_coefficients_for_write(const SpectralImage& image, bool multi, Imf::Header& header,
-                                         Imf::FrameBuffer& fb, const std::string& path) {
+                                         Imf::FrameBuffer& fb, const std::string& path,
+                                         std::list<std::vector<half>>& buffers) {
   const bool any = std::any_of(image.lights.begin(), image.lights.end(),
                                [](const TransportLayer& l) { return l.coefficients.k != 0; });
   if (!any) return 0;
@@ -97,17 +123,19 @@ std::uint64_t add_coefficients_for_write(const SpectralImage& image, bool multi,
     }
     check_finite(c.basis, "basis of light \"" + light.name + "\"", path);
     check_finite(c.values, what, path);
+    check_half_range(c.values, k, static_cast<std::size_t>(image.width), what, path);
     const std::string prefix = multi ? light.name + "." : std::string();
-    const std::size_t x_stride = sizeof(float) * k;
+    std::vector<half>& rounded = buffers.emplace_back(c.values.begin(), c.values.end());  // nearest, ties to even
+    const std::size_t x_stride = sizeof(half) * k;
     const std::size_t y_stride = x_stride * static_cast<std::size_t>(image.width);
-    const char* base = reinterpret_cast<const char*>(c.values.data());
+    const char* base = reinterpret_cast<const char*>(rounded.data());
     for (std::size_t j = 0; j < k; ++j) {
       const std::string name = channel_name(prefix, static_cast<int>(j));
-      header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-      fb.insert(name, Imf::Slice(Imf::FLOAT, const_cast<char*>(base + sizeof(float) * j), x_stride, y_stride));
+      header.channels().insert(name, Imf::Channel(Imf::HALF));
+      fb.insert(name, Imf::Slice(Imf::HALF, const_cast<char*>(base + sizeof(half) * j), x_stride, y_stride));
     }
     header.insert(kAttrBasisPrefix + light.name, Imf::FloatVectorAttribute(Imf::FloatVector(c.basis.begin(), c.basis.end())));
-    sum += hash_floats(c.values.data(), c.values.size(), kFnvBasisCoefficients);
+    sum += hash_halves(rounded.data(), rounded.size(), kFnvBasisCoefficients);
     sum += hash_floats(c.basis.data(), c.basis.size(), kFnvBasisVectors);
     nlohmann::json errors = nlohmann::json::array();
     for (const BasisError& e : c.errors) errors.push_back({{"light", e.light}, {"percentile", e.percentile}, {"max", e.max}});

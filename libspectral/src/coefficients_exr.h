@@ -7,7 +7,10 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 
+#include <half.h>
+
 #include <cstdint>
+#include <list>
 #include <string>
 #include <vector>
 
@@ -24,11 +27,13 @@ struct CoefficientChannel {
 // True (and `out` filled) when `name` is a coefficient channel [<layer>.]coef.<j>.
 bool parse_coefficient_channel(const std::string& name, CoefficientChannel& out);
 
-// Writing: validates the layers' coefficients (all layers or none, sizes, finite values), adds the
-// channels (per light layer when `multi`, else top level), their slices and the attributes, and
-// returns the checksum contribution. Nothing (0) when no layer has coefficients.
+// Writing: validates the layers' coefficients (all layers or none, sizes, finite values within
+// half's range), adds the half channels (per light layer when `multi`, else top level), their
+// slices (the values rounded to half into `buffers`, which must outlive the write) and the
+// attributes, and returns the checksum contribution. Nothing (0) when no layer has coefficients.
 std::uint64_t add_coefficients_for_write(const SpectralImage& image, bool multi, Imf::Header& header,
-                                         Imf::FrameBuffer& fb, const std::string& path);
+                                         Imf::FrameBuffer& fb, const std::string& path,
+                                         std::list<std::vector<half>>& buffers);
 
 // Reading: for each light (image.lights, already named; `layers` their channel prefixes in the same
 // order) finds its coefficient channels, reads its basis from the header and adds slices into

@@ -70,24 +70,34 @@ std::vector<TestLight> prepare_lights(const float* data, int n, const std::vecto
   return out;
 }
 
-std::vector<BasisError> errors_at(const SpectralBasis& basis, int k, const float* data, int n,
-                                  const std::vector<std::size_t>& samples, const std::vector<TestLight>& lights,
-                                  double q) {
-  const Eigen::MatrixXd bk = basis.vectors.leftCols(k);
-  const Eigen::MatrixXd projector = bk * bk.transpose();
+// ΔE00 of each test light's relit reconstruction at every sample, against the exact: `weights(w_l)`
+// gives the 3×m matrix from the light's 3×n weights and `vector(i)` sample i's m values (the
+// spectrum, or its coefficients), as floats.
+template <class Weights, class Vector>
+std::vector<BasisError> errors_of(const std::vector<TestLight>& lights, std::size_t samples, double q, Weights weights,
+                                  Vector vector) {
   std::vector<BasisError> out;
-  std::vector<double> de(samples.size());
+  std::vector<double> de(samples);
   for (const TestLight& light : lights) {
-    const Eigen::Matrix<double, 3, Eigen::Dynamic> w = light.weights * projector;
+    const Eigen::Matrix<double, 3, Eigen::Dynamic> w = weights(light.weights);
     double worst = 0.0;
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      const Eigen::Map<const Eigen::VectorXf> t(data + samples[i] * static_cast<std::size_t>(n), n);
-      de[i] = delta_e2000(light.exact_lab[i], xyz_to_lab(w * t.cast<double>(), light.white));
+    for (std::size_t i = 0; i < samples; ++i) {
+      de[i] = delta_e2000(light.exact_lab[i], xyz_to_lab(w * vector(i).template cast<double>(), light.white));
       worst = std::max(worst, de[i]);
     }
     out.push_back({light.name, percentile_of(de, q), worst});
   }
   return out;
+}
+
+std::vector<BasisError> errors_at(const SpectralBasis& basis, int k, const float* data, int n,
+                                  const std::vector<std::size_t>& samples, const std::vector<TestLight>& lights,
+                                  double q) {
+  const Eigen::MatrixXd bk = basis.vectors.leftCols(k);
+  const Eigen::MatrixXd projector = bk * bk.transpose();
+  return errors_of(
+      lights, samples.size(), q, [&](const Eigen::Matrix<double, 3, Eigen::Dynamic>& w) { return w * projector; },
+      [&](std::size_t i) { return Eigen::Map<const Eigen::VectorXf>(data + samples[i] * static_cast<std::size_t>(n), n); });
 }
 
 }  // namespace
@@ -153,6 +163,23 @@ std::vector<BasisError> basis_errors(const SpectralBasis& basis, int k, const fl
   const auto samples = sample_pixels(pixels, criterion.max_samples);
   const auto lights = prepare_lights(data, n, samples, bins, criterion);
   return errors_at(basis, k, data, n, samples, lights, criterion.percentile);
+}
+
+std::vector<BasisError> reconstruction_errors(const Eigen::MatrixXf& basis, const float* coefficients, const float* data,
+                                              std::size_t pixels, const BinLayout& bins, const BasisCriterion& criterion) {
+  const int n = static_cast<int>(basis.rows());
+  const int k = static_cast<int>(basis.cols());
+  if (n != bins.size() || k < 1 || k > n) {
+    throw InputError("spectral basis", std::to_string(n) + "×" + std::to_string(k) + " basis for " +
+                                           std::to_string(bins.size()) + " bins");
+  }
+  const auto samples = sample_pixels(pixels, criterion.max_samples);
+  const auto lights = prepare_lights(data, n, samples, bins, criterion);
+  const Eigen::MatrixXd b = basis.cast<double>();
+  return errors_of(
+      lights, samples.size(), criterion.percentile,
+      [&](const Eigen::Matrix<double, 3, Eigen::Dynamic>& w) { return w * b; },
+      [&](std::size_t i) { return Eigen::Map<const Eigen::VectorXf>(coefficients + samples[i] * static_cast<std::size_t>(k), k); });
 }
 
 BasisChoice choose_basis_size(const SpectralBasis& basis, const float* data, std::size_t pixels,

@@ -580,8 +580,8 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
     checksum += rc;
     header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum)));
   }
-  // Spectral-basis coefficients (float32 whatever the pixel type; none for most files).
-  if (const std::uint64_t cc = detail::add_coefficients_for_write(image, multi, header, fb, p); cc != 0) {
+  // Spectral-basis coefficients (half whatever the pixel type; none for most files).
+  if (const std::uint64_t cc = detail::add_coefficients_for_write(image, multi, header, fb, p, half_buffers); cc != 0) {
     header.insert(kAttrChecksum, Imf::StringAttribute(checksum_string(checksum + cc)));
   }
   if (!preview.empty()) {
@@ -830,6 +830,8 @@ std::string reencoding_signs(const Imf::Header& h) {
   }
   bool any_half = false, any_float = false;
   for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+    // Coefficient channels are half in every Prizma file (float in files of 2026-12-01), whatever the bins'.
+    if (detail::CoefficientChannel cc; detail::parse_coefficient_channel(it.name(), cc)) continue;
     (it.channel().type == Imf::HALF ? any_half : any_float) = true;
   }
   if (any_half && any_float) signs.push_back("it mixes half and float channels");

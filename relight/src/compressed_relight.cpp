@@ -4,6 +4,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <Imath/half.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -20,19 +22,20 @@ namespace prizma::relight {
 
 namespace {
 
-// One light's 3×k weights (row-major) and its coefficients.
+// One light's 3×k weights (row-major) and its half coefficients.
 struct CoeffTerm {
   const float* weights;
-  const float* coefficients;
+  const std::uint16_t* coefficients;
   int k;
 };
 
-// Adds Σ_j W[:, j]·c(p, j) for a row of pixels into out (3 floats per pixel). K > 0 fixes k.
+// Adds Σ_j W[:, j]·c(x, j) for a row of pixels into out (3 floats per pixel); `row` holds the row's
+// coefficients as floats (width·k, pixel-major). K > 0 fixes k.
 template <int K>
-void add_row(const CoeffTerm& term, std::size_t first_pixel, int width, float* out) {
+void add_row(const CoeffTerm& term, const float* row, int width, float* out) {
   const int k = K > 0 ? K : term.k;
   const float* w = term.weights;
-  const float* c = term.coefficients + first_pixel * static_cast<std::size_t>(k);
+  const float* c = row;
   for (int x = 0; x < width; ++x, c += k) {
     float X = 0.0f, Y = 0.0f, Z = 0.0f;
     for (int j = 0; j < k; ++j) {
@@ -46,7 +49,7 @@ void add_row(const CoeffTerm& term, std::size_t first_pixel, int width, float* o
   }
 }
 
-using AddRow = void (*)(const CoeffTerm&, std::size_t, int, float*);
+using AddRow = void (*)(const CoeffTerm&, const float*, int, float*);
 
 AddRow add_row_for(int k) {
   switch (k) {
@@ -101,6 +104,37 @@ std::uint8_t quantise(float v) {
 
 }  // namespace
 
+void set_half_coefficients(CompressedLayer& layer, const Eigen::MatrixXf& basis, const std::vector<float>& coefficients) {
+  const auto k = static_cast<std::size_t>(basis.cols());
+  if (k < 1 || coefficients.size() % k != 0) {
+    throw spectral::RuntimeError("compressed layer " + layer.name + ": " + std::to_string(coefficients.size()) +
+                                 " coefficients for k = " + std::to_string(k));
+  }
+  float largest = 0.0f;
+  for (std::size_t i = 0; i < coefficients.size(); ++i) {
+    if (!std::isfinite(coefficients[i])) {
+      throw spectral::RuntimeError("compressed layer " + layer.name + ": non-finite coefficient at pixel " +
+                                   std::to_string(i / k) + ", coefficient " + std::to_string(i % k));
+    }
+    largest = std::max(largest, std::fabs(coefficients[i]));
+  }
+  // 2^e with largest / 2^e in [2^14, 2^15): within half's range (65504) with room for rounding, and
+  // as far above half's subnormals (below 2^-14) as it goes. Powers of two scale exactly.
+  const int e = largest > 0.0f ? std::max(std::ilogb(largest) - 14, -100) : 0;
+  const float down = std::ldexp(1.0f, -e);
+  layer.k = static_cast<int>(k);
+  layer.basis = basis * std::ldexp(1.0f, e);
+  layer.coefficients.resize(coefficients.size());
+  for (std::size_t i = 0; i < coefficients.size(); ++i) layer.coefficients[i] = half(coefficients[i] * down).bits();
+}
+
+Eigen::VectorXf reconstructed_spectrum(const CompressedLayer& layer, std::size_t p) {
+  Eigen::VectorXf c(layer.k);
+  detail::half_to_float(layer.coefficients.data() + p * static_cast<std::size_t>(layer.k), static_cast<std::size_t>(layer.k),
+                        c.data());
+  return layer.basis * c;
+}
+
 CompressedTransport compress_transport(const spectral::SpectralImage& image, const spectral::BasisCriterion& criterion) {
   CompressedTransport out;
   out.width = image.width;
@@ -118,10 +152,17 @@ CompressedTransport compress_transport(const spectral::SpectralImage& image, con
         spectral::choose_basis_size(basis, layer.data.data(), pixels, image.bins, criterion);
     CompressedLayer c;
     c.name = layer.name;
-    c.k = choice.k;
-    c.basis = spectral::basis_columns(basis, choice.k);
-    c.coefficients = spectral::project_coefficients(basis, choice.k, layer.data.data(), pixels);
-    c.errors = choice.errors;
+    // Half coefficients and their errors; one more coefficient while rounding breaks the bound
+    // (k = n: as good as it gets).
+    for (c.k = choice.k;; ++c.k) {
+      std::vector<float> values = spectral::project_coefficients(basis, c.k, layer.data.data(), pixels);
+      set_half_coefficients(c, spectral::basis_columns(basis, c.k), values);
+      detail::half_to_float(c.coefficients.data(), c.coefficients.size(), values.data());
+      c.errors = spectral::reconstruction_errors(c.basis, values.data(), layer.data.data(), pixels, image.bins, criterion);
+      const bool ok = std::all_of(c.errors.begin(), c.errors.end(),
+                                  [&](const spectral::BasisError& e) { return e.percentile <= criterion.max_delta_e; });
+      if (ok || c.k >= n) break;
+    }
     out.lights.push_back(std::move(c));
   }
   return out;
@@ -139,12 +180,19 @@ void relight_compressed_into(const CompressedTransport& transport, const Relight
     kernels.push_back(add_row_for(layer.k));
   }
   const int width = transport.width;
+  int max_k = 1;
+  for (const CoeffTerm& t : terms) max_k = std::max(max_k, t.k);
   tbb::parallel_for(tbb::blocked_range<int>(0, transport.height), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<float> row(static_cast<std::size_t>(width) * static_cast<std::size_t>(max_k));
     for (int y = rows.begin(); y != rows.end(); ++y) {
       const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
       float* out = xyz_out + 3 * first;
       std::fill(out, out + 3 * static_cast<std::size_t>(width), 0.0f);
-      for (std::size_t t = 0; t < terms.size(); ++t) kernels[t](terms[t], first, width, out);
+      for (std::size_t t = 0; t < terms.size(); ++t) {
+        const std::size_t count = static_cast<std::size_t>(width) * static_cast<std::size_t>(terms[t].k);
+        detail::half_to_float(terms[t].coefficients + first * static_cast<std::size_t>(terms[t].k), count, row.data());
+        kernels[t](terms[t], row.data(), width, out);
+      }
     }
   });
 }
@@ -380,10 +428,8 @@ CompressedTransport take_coefficients(spectral::SpectralImage& image, const std:
     }
     CompressedLayer l;
     l.name = layer.name;
-    l.k = c.k;
-    l.basis = Eigen::Map<const Eigen::MatrixXf>(c.basis.data(), n, c.k);
-    l.coefficients = std::move(c.values);
-    c.values.clear();
+    set_half_coefficients(l, Eigen::Map<const Eigen::MatrixXf>(c.basis.data(), n, c.k), c.values);
+    std::vector<float>().swap(c.values);
     l.errors = c.errors;
     out.lights.push_back(std::move(l));
   }
@@ -410,7 +456,8 @@ void store_coefficients(spectral::SpectralImage& image, const CompressedTranspor
     spectral::TransportLayer& layer = image.lights[l];
     layer.coefficients.k = c.k;
     layer.coefficients.basis.assign(c.basis.data(), c.basis.data() + c.basis.size());  // column-major: vector-major
-    layer.coefficients.values = c.coefficients;
+    layer.coefficients.values.resize(c.coefficients.size());  // the half values, as floats
+    detail::half_to_float(c.coefficients.data(), c.coefficients.size(), layer.coefficients.values.data());
     layer.coefficients.errors = c.errors;
     if (compact) {
       layer.data = {};
@@ -447,7 +494,7 @@ CompressedTransport compress_spectral_exr(const std::filesystem::path& input, co
 void relight_compressed_to_display8(const CompressedTransport& transport, const RelightMatrix& matrix,
                                     const DisplayEncoder8& encoder, std::uint8_t* rgb_out) {
   const std::size_t pixels = transport.pixel_count();
-  if (!encoder.baked() || encoder.small_lut(0).empty()) {
+  if (!encoder.baked() || encoder.small_lut(0).empty() || transport.lights.size() > detail::kMaxFusedLayers) {
     std::vector<float> xyz(3 * pixels);
     relight_compressed_into(transport, matrix, xyz.data());
     encoder.encode(xyz.data(), pixels, rgb_out);
@@ -467,8 +514,9 @@ void relight_compressed_to_display8(const CompressedTransport& transport, const 
   enc.lut_size = static_cast<int>(encoder.small_lut(0).size());
   enc.lut_scale = encoder.small_lut_scale();
   const int width = transport.width;
+  const std::size_t scratch_floats = detail::compressed_row_scratch(terms.data(), static_cast<int>(terms.size()), width);
   tbb::parallel_for(tbb::blocked_range<int>(0, transport.height), [&](const tbb::blocked_range<int>& rows) {
-    std::vector<float> scratch(3 * static_cast<std::size_t>(width) + 64);
+    std::vector<float> scratch(scratch_floats);
     for (int y = rows.begin(); y != rows.end(); ++y) {
       const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
       detail::compressed_row_to_display8(terms.data(), static_cast<int>(terms.size()), first, width, enc, scratch.data(),

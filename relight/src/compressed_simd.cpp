@@ -1,15 +1,21 @@
 // The fused compressed-relight row (compressed_simd.h), compiled for every x86 SIMD level with
-// Highway and chosen at run time, as relight_simd.cpp does. Per block of lanes: the coefficients of
-// each light are de-interleaved (LoadInterleaved2/3/4 for k ≤ 4, gathers otherwise), multiplied into
-// linear display RGB with the folded 3×k weights, and each channel is encoded by the small table: one
-// gather for the guess, one for the next threshold, one compare. Targets differ only in float
-// rounding of the sums (FMA or not); one machine always gives the same bytes.
+// Highway and chosen at run time, as relight_simd.cpp does. Per block of lanes: the half
+// coefficients of each light are de-interleaved (LoadInterleaved2/3/4 of 16-bit lanes for k ≤ 4;
+// layers of larger k are first converted for the whole row and gathered), widened to float (F16C
+// where the target has it: exact either way), multiplied into linear display RGB with the folded 3×k
+// weights, and each channel is encoded by the small table: one gather for the guess, one for the
+// next threshold, one compare; the codes are narrowed to bytes and stored interleaved. Each
+// coefficient is read from memory once and nothing but the 8-bit codes is written. The row's tail
+// goes through the same block on zero-padded copies, so every pixel gets the same arithmetic.
+// Targets differ only in float rounding of the sums (FMA or not); one machine always gives the
+// same bytes.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "compressed_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <cstring>
 
 #include "compressed_simd.h"
 
@@ -19,94 +25,130 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 namespace {
 
-// Linear RGB of one pixel, scalar (tails).
-void pixel_rgb(const SimdCoeffLayer* layers, int layer_count, std::size_t p, float rgb[3]) {
-  rgb[0] = rgb[1] = rgb[2] = 0.0f;
-  for (int l = 0; l < layer_count; ++l) {
-    const int k = layers[l].k;
-    const float* w = layers[l].weights;
-    const float* c = layers[l].coefficients + p * static_cast<std::size_t>(k);
-    for (int j = 0; j < k; ++j) {
-      rgb[0] += w[j] * c[j];
-      rgb[1] += w[k + j] * c[j];
-      rgb[2] += w[2 * k + j] * c[j];
-    }
-  }
+using DF = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<DF>;
+using DH = hn::Rebind<std::uint16_t, DF>;      // one 16-bit lane per float lane
+using DF16 = hn::Rebind<hwy::float16_t, DF>;
+using DB = hn::Rebind<std::uint8_t, DF>;
+using VF = hn::Vec<DF>;
+static_assert(HWY_LANES(float) <= kMaxSimdLanes, "the tail buffers hold one block of the widest target");
+
+VF widen(hn::Vec<DH> h) {
+  const DF d;
+  const DF16 d16;
+  return hn::PromoteTo(d, hn::BitCast(d16, h));
 }
 
-std::uint8_t code_scalar(const SimdEncoder& e, int c, float v) {
-  if (!(v > 0.0f)) v = 0.0f;  // negatives (and NaN) take the code of 0
-  const float x = std::min(v * e.lut_scale, static_cast<float>(e.lut_size - 1));
-  int code = e.lut[c][static_cast<int>(x)];
-  if (v >= e.thresholds[c][code + 1]) ++code;
-  return static_cast<std::uint8_t>(code);
+// One block of Lanes(DF) pixels: `coeff[l]` the first of the block's halves of small-k layer l,
+// `big[l]` its floats for layers of k > 4 (row-converted); writes 3·lanes codes to `out`.
+HWY_INLINE void block(const SimdCoeffLayer* layers, int layer_count, const std::uint16_t* const* coeff,
+                      const float* const* big, const SimdEncoder& e, std::uint8_t* HWY_RESTRICT out) {
+  const DF d;
+  const DI di;
+  const DH dh;
+  const DB db;
+  VF r = hn::Zero(d), g = hn::Zero(d), b = hn::Zero(d);
+  for (int l = 0; l < layer_count; ++l) {
+    const int k = layers[l].k;
+    const float* HWY_RESTRICT w = layers[l].weights;
+    auto add = [&](int j, VF cj) {
+      r = hn::MulAdd(hn::Set(d, w[j]), cj, r);
+      g = hn::MulAdd(hn::Set(d, w[k + j]), cj, g);
+      b = hn::MulAdd(hn::Set(d, w[2 * k + j]), cj, b);
+    };
+    const std::uint16_t* HWY_RESTRICT c = coeff[l];
+    if (k == 4) {
+      hn::Vec<DH> h0, h1, h2, h3;
+      hn::LoadInterleaved4(dh, c, h0, h1, h2, h3);
+      add(0, widen(h0)), add(1, widen(h1)), add(2, widen(h2)), add(3, widen(h3));
+    } else if (k == 3) {
+      hn::Vec<DH> h0, h1, h2;
+      hn::LoadInterleaved3(dh, c, h0, h1, h2);
+      add(0, widen(h0)), add(1, widen(h1)), add(2, widen(h2));
+    } else if (k == 2) {
+      hn::Vec<DH> h0, h1;
+      hn::LoadInterleaved2(dh, c, h0, h1);
+      add(0, widen(h0)), add(1, widen(h1));
+    } else if (k == 1) {
+      add(0, widen(hn::LoadU(dh, c)));
+    } else {
+      const float* HWY_RESTRICT f = big[l];
+      const auto base = hn::Mul(hn::Iota(di, 0), hn::Set(di, k));
+      for (int j = 0; j < k; ++j) add(j, hn::GatherIndex(d, f, hn::Add(base, hn::Set(di, j))));
+    }
+  }
+  const auto zero = hn::Zero(d);
+  const auto lut_max = hn::Set(d, static_cast<float>(e.lut_size - 1));
+  const auto scale = hn::Set(d, e.lut_scale);
+  const auto one = hn::Set(di, 1);
+  const VF v[3] = {r, g, b};
+  hn::Vec<DB> codes[3];
+  for (int ch = 0; ch < 3; ++ch) {
+    const auto vc = hn::Max(v[ch], zero);  // negatives (and NaN) take the code of 0
+    const auto idx = hn::ConvertTo(di, hn::Min(hn::Mul(vc, scale), lut_max));
+    auto code = hn::GatherIndex(di, e.lut[ch], idx);
+    const auto next = hn::GatherIndex(d, e.thresholds[ch], hn::Add(code, one));
+    code = hn::IfThenElse(hn::RebindMask(di, hn::Ge(vc, next)), hn::Add(code, one), code);
+    codes[ch] = hn::DemoteTo(db, code);  // 0..255
+  }
+  hn::StoreInterleaved3(codes[0], codes[1], codes[2], db, out);
 }
 
 }  // namespace
 
 void CompressedRowToDisplay8(const SimdCoeffLayer* layers, int layer_count, std::size_t first_pixel, int width,
                              const SimdEncoder& e, float* scratch, std::uint8_t* out) {
-  const hn::ScalableTag<float> d;
-  const hn::RebindToSigned<decltype(d)> di;
-  using V = hn::Vec<decltype(d)>;
+  const DF d;
+  const DH dh;
   const int lanes = static_cast<int>(hn::Lanes(d));
-  const auto zero = hn::Zero(d);
-  const auto lut_max = hn::Set(d, static_cast<float>(e.lut_size - 1));
-  const auto scale = hn::Set(d, e.lut_scale);
-  const auto one = hn::Set(di, 1);
-  float* codes = scratch;  // 3 · lanes floats' room, as int32
-  std::int32_t* code_i = reinterpret_cast<std::int32_t*>(codes);
+  const int count = std::min(layer_count, kMaxFusedLayers);  // the caller's limit
+  const std::uint16_t* coeff[kMaxFusedLayers];
+  const float* big[kMaxFusedLayers];
+  // Per layer of k > 4: its row converted to float in the scratch, zero-padded by a block.
+  float* s = scratch;
+  for (int l = 0; l < count; ++l) {
+    const int k = layers[l].k;
+    const std::uint16_t* c = layers[l].coefficients + first_pixel * static_cast<std::size_t>(k);
+    coeff[l] = c;
+    big[l] = nullptr;
+    if (k > 4) {
+      const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(k);
+      std::size_t i = 0;
+      for (; i + hn::Lanes(d) <= n; i += hn::Lanes(d)) hn::StoreU(widen(hn::LoadU(dh, c + i)), d, s + i);
+      for (; i < n; ++i) s[i] = hn::GetLane(widen(hn::Set(dh, c[i])));
+      std::fill(s + n, s + n + static_cast<std::size_t>(kMaxSimdLanes) * static_cast<std::size_t>(k), 0.0f);
+      big[l] = s;
+      s += static_cast<std::size_t>(width + kMaxSimdLanes) * static_cast<std::size_t>(k);
+    }
+  }
   int x = 0;
   for (; x + lanes <= width; x += lanes) {
-    const std::size_t p = first_pixel + static_cast<std::size_t>(x);
-    auto r = zero, g = zero, b = zero;
-    for (int l = 0; l < layer_count; ++l) {
-      const int k = layers[l].k;
-      const float* HWY_RESTRICT w = layers[l].weights;
-      const float* HWY_RESTRICT c = layers[l].coefficients + p * static_cast<std::size_t>(k);
-      auto add = [&](int j, V cj) {
-        r = hn::MulAdd(hn::Set(d, w[j]), cj, r);
-        g = hn::MulAdd(hn::Set(d, w[k + j]), cj, g);
-        b = hn::MulAdd(hn::Set(d, w[2 * k + j]), cj, b);
-      };
-      if (k == 4) {
-        V c0, c1, c2, c3;
-        hn::LoadInterleaved4(d, c, c0, c1, c2, c3);
-        add(0, c0), add(1, c1), add(2, c2), add(3, c3);
-      } else if (k == 3) {
-        V c0, c1, c2;
-        hn::LoadInterleaved3(d, c, c0, c1, c2);
-        add(0, c0), add(1, c1), add(2, c2);
-      } else if (k == 2) {
-        V c0, c1;
-        hn::LoadInterleaved2(d, c, c0, c1);
-        add(0, c0), add(1, c1);
-      } else {
-        const auto base = hn::Mul(hn::Iota(di, 0), hn::Set(di, k));
-        for (int j = 0; j < k; ++j) add(j, hn::GatherIndex(d, c, hn::Add(base, hn::Set(di, j))));
-      }
-    }
-    const V v[3] = {r, g, b};
-    for (int ch = 0; ch < 3; ++ch) {
-      const auto vc = hn::Max(v[ch], zero);
-      const auto idx = hn::ConvertTo(di, hn::Min(hn::Mul(vc, scale), lut_max));
-      auto code = hn::GatherIndex(di, e.lut[ch], idx);
-      const auto next = hn::GatherIndex(d, e.thresholds[ch], hn::Add(code, one));
-      code = hn::IfThenElse(hn::RebindMask(di, hn::Ge(vc, next)), hn::Add(code, one), code);
-      hn::StoreU(code, di, code_i + ch * lanes);
-    }
-    std::uint8_t* o = out + 3 * static_cast<std::size_t>(x);
-    for (int i = 0; i < lanes; ++i) {
-      o[3 * i + 0] = static_cast<std::uint8_t>(code_i[i]);
-      o[3 * i + 1] = static_cast<std::uint8_t>(code_i[lanes + i]);
-      o[3 * i + 2] = static_cast<std::uint8_t>(code_i[2 * lanes + i]);
+    block(layers, count, coeff, big, e, out + 3 * static_cast<std::size_t>(x));
+    for (int l = 0; l < count; ++l) {
+      coeff[l] += static_cast<std::size_t>(lanes) * static_cast<std::size_t>(layers[l].k);
+      if (big[l] != nullptr) big[l] += static_cast<std::size_t>(lanes) * static_cast<std::size_t>(layers[l].k);
     }
   }
-  for (; x < width; ++x) {
-    float rgb[3];
-    pixel_rgb(layers, layer_count, first_pixel + static_cast<std::size_t>(x), rgb);
-    for (int ch = 0; ch < 3; ++ch) out[3 * static_cast<std::size_t>(x) + static_cast<std::size_t>(ch)] = code_scalar(e, ch, rgb[ch]);
+  if (x < width) {  // the tail: the same block on zero-padded copies
+    const int rest = width - x;
+    std::uint16_t tail[kMaxFusedLayers][kMaxSimdLanes * 4] = {};
+    for (int l = 0; l < count; ++l) {
+      if (big[l] != nullptr) continue;
+      std::copy(coeff[l], coeff[l] + static_cast<std::size_t>(rest) * static_cast<std::size_t>(layers[l].k), tail[l]);
+      coeff[l] = tail[l];
+    }
+    std::uint8_t codes[3 * kMaxSimdLanes];
+    block(layers, count, coeff, big, e, codes);
+    std::memcpy(out + 3 * static_cast<std::size_t>(x), codes, 3 * static_cast<std::size_t>(rest));
   }
+}
+
+void HalfToFloat(const std::uint16_t* in, std::size_t count, float* out) {
+  const DF d;
+  const DH dh;
+  std::size_t i = 0;
+  for (; i + hn::Lanes(d) <= count; i += hn::Lanes(d)) hn::StoreU(widen(hn::LoadU(dh, in + i)), d, out + i);
+  for (; i < count; ++i) out[i] = hn::GetLane(widen(hn::Set(dh, in[i])));
 }
 
 }  // namespace prizma::relight::detail::HWY_NAMESPACE
@@ -116,10 +158,15 @@ HWY_AFTER_NAMESPACE();
 namespace prizma::relight::detail {
 
 HWY_EXPORT(CompressedRowToDisplay8);
+HWY_EXPORT(HalfToFloat);
 
 void compressed_row_to_display8(const SimdCoeffLayer* layers, int layer_count, std::size_t first_pixel, int width,
                                 const SimdEncoder& encoder, float* scratch, std::uint8_t* out) {
   HWY_DYNAMIC_DISPATCH(CompressedRowToDisplay8)(layers, layer_count, first_pixel, width, encoder, scratch, out);
+}
+
+void half_to_float(const std::uint16_t* in, std::size_t count, float* out) {
+  HWY_DYNAMIC_DISPATCH(HalfToFloat)(in, count, out);
 }
 
 }  // namespace prizma::relight::detail

@@ -1,16 +1,17 @@
 #pragma once
 // The fused row kernel of relight_compressed_to_display8 (compressed_simd.cpp, Highway run-time
-// dispatch like relight_simd.cpp): coefficients → linear display RGB → 8-bit codes, one row at a time.
+// dispatch like relight_simd.cpp): half coefficients → linear display RGB → 8-bit codes, one row at
+// a time; and the half → float conversion of relight_compressed_into.
 #include <cstddef>
 #include <cstdint>
 
 namespace prizma::relight::detail {
 
 // One light: its 3×k weights, row-major (R, G, B rows: the display matrix folded in), and its
-// coefficients (pixel-major, k contiguous).
+// coefficients as IEEE binary16 bits (pixel-major, k contiguous).
 struct SimdCoeffLayer {
   const float* weights;
-  const float* coefficients;
+  const std::uint16_t* coefficients;
   int k;
 };
 
@@ -23,8 +24,25 @@ struct SimdEncoder {
   float lut_scale = 0.0f;
 };
 
-// out[3x + c] for x in [0, width): the codes of pixel first_pixel + x. `scratch`: 3·width + 64 floats.
+// The most float lanes of any target (AVX-512: 16), and the most lights one fused row takes.
+constexpr int kMaxSimdLanes = 16;
+constexpr int kMaxFusedLayers = 64;
+
+// Floats of scratch compressed_row_to_display8 needs for a row of `width` pixels: per layer with
+// k > 4 its row of coefficients as floats, plus a block of zero padding.
+inline std::size_t compressed_row_scratch(const SimdCoeffLayer* layers, int layer_count, int width) {
+  std::size_t n = 0;
+  for (int l = 0; l < layer_count; ++l)
+    if (layers[l].k > 4) n += static_cast<std::size_t>(width + kMaxSimdLanes) * static_cast<std::size_t>(layers[l].k);
+  return n;
+}
+
+// out[3x + c] for x in [0, width): the codes of pixel first_pixel + x. At most kMaxFusedLayers
+// layers; `scratch`: compressed_row_scratch(layers, layer_count, width) floats.
 void compressed_row_to_display8(const SimdCoeffLayer* layers, int layer_count, std::size_t first_pixel, int width,
                                 const SimdEncoder& encoder, float* scratch, std::uint8_t* out);
+
+// out[i] = the float of half bits in[i] (exact), i < count.
+void half_to_float(const std::uint16_t* in, std::size_t count, float* out);
 
 }  // namespace prizma::relight::detail

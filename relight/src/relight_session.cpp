@@ -244,8 +244,7 @@ ProbeResult RelightSession::probe(int x, int y) {
   for (std::size_t l = 0; l < m_image.lights.size(); ++l) {
     const auto& layer = m_image.lights[l];
     if (layer.data.empty() && m_compressed) {  // compact: the bins as the coefficients give them, B·c
-      const CompressedLayer& c = m_compressed->lights[l];
-      const Eigen::VectorXf t = c.basis * Eigen::Map<const Eigen::VectorXf>(c.coefficients.data() + p * static_cast<std::size_t>(c.k), c.k);
+      const Eigen::VectorXf t = reconstructed_spectrum(m_compressed->lights[l], p);
       r.bins.emplace_back(t.data(), t.data() + t.size());
       continue;
     }

@@ -3,6 +3,8 @@
 // display encoder writes what write_output_image writes into an 8-bit PNG.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <Imath/half.h>
+#include <hwy/targets.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -39,37 +41,103 @@ spectral::SpectralImage smooth_image(int width, int height, int bins) {
 
 std::vector<LightSpec> two_lights() { return {parse_light_spec("D65"), parse_light_spec("A*0.7")}; }
 
+// How two 8-bit images differ: the values that differ and the largest difference.
+struct CodeDiff {
+  std::size_t differ = 0;
+  int worst = 0;
+};
+CodeDiff code_diff(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
+  CodeDiff out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const int d = std::abs(int{a[i]} - int{b[i]});
+    out.worst = std::max(out.worst, d);
+    out.differ += d != 0;
+  }
+  return out;
+}
+
 double max_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
   double d = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, double(std::abs(a[i] - b[i])));
   return d;
 }
 
-TEST(CompressedRelight, EqualsExactRelightWhenKIsN) {
+// The image with each layer's spectra replaced by the compressed transport's reconstruction B·c.
+spectral::SpectralImage reconstructed(const spectral::SpectralImage& img, const CompressedTransport& t) {
+  spectral::SpectralImage back = img;
+  const std::size_t n = static_cast<std::size_t>(img.bins.size());
+  for (std::size_t l = 0; l < t.lights.size(); ++l) {
+    for (std::size_t p = 0; p < img.pixel_count(); ++p) {
+      const Eigen::VectorXf s = reconstructed_spectrum(t.lights[l], p);
+      std::copy(s.data(), s.data() + n, back.lights[l].data.begin() + static_cast<std::ptrdiff_t>(p * n));
+    }
+  }
+  return back;
+}
+
+// At k = n the only loss is half rounding: with an orthonormal basis each bin's error is at most
+// ‖δc‖ ≤ 2⁻¹¹·‖c‖ = 2⁻¹¹·‖t_p‖ (half's unit roundoff, round to nearest), plus float rounding.
+TEST(CompressedRelight, AtKEqualToNOnlyHalfRoundingIsLost) {
   const auto img = smooth_image(40, 30, 16);
   spectral::BasisCriterion all;
   all.max_delta_e = -1.0;  // no k < n passes: k = n
   const CompressedTransport t = compress_transport(img, all);
-  for (const auto& layer : t.lights) EXPECT_EQ(layer.k, 16);
+  const spectral::SpectralImage back = reconstructed(img, t);
+  double worst = 0.0, worst_float = 0.0;
+  for (std::size_t l = 0; l < t.lights.size(); ++l) {
+    EXPECT_EQ(t.lights[l].k, 16);
+    for (std::size_t p = 0; p < img.pixel_count(); ++p) {
+      const Eigen::Map<const Eigen::VectorXf> exact(img.lights[l].data.data() + 16 * p, 16);
+      const Eigen::Map<const Eigen::VectorXf> mine(back.lights[l].data.data() + 16 * p, 16);
+      worst = std::max(worst, double((exact - mine).cwiseAbs().maxCoeff() / exact.norm()));
+      worst_float = std::max(worst_float, double((exact - mine).cwiseAbs().maxCoeff()));
+    }
+  }
+  EXPECT_LE(worst, std::ldexp(1.0, -11) + 1e-6);
+  EXPECT_GT(worst_float, 1e-6) << "half, not float: some bin moves";
   const RelightMatrix m(img.bins, two_lights(), {});
-  EXPECT_LT(max_abs_diff(relight_compressed(t, m).xyz, relight_image(img, m).xyz), 2e-5);
+  EXPECT_LT(max_abs_diff(relight_compressed(t, m).xyz, relight_image(back, m).xyz), 2e-5);
+}
+
+// The coefficients are scaled by a power of two into [2^14, 2^15) per layer, so the transport's
+// level does not change what is stored: the same half bits for the image times 2^40 and 2^-40
+// (beyond half's range either way), the basis scaled exactly. (k fixed at n: the ΔE criterion,
+// relative to a white of Y = 1, sees a brighter image differently.)
+TEST(CompressedRelight, HalfCoefficientsKeepTheirPrecisionAtAnyLevel) {
+  const auto img = smooth_image(24, 16, 16);
+  spectral::BasisCriterion all;
+  all.max_delta_e = -1.0;
+  const CompressedTransport t = compress_transport(img, all);
+  for (const CompressedLayer& c : t.lights) {
+    float largest = 0.0f;
+    for (const std::uint16_t bits : c.coefficients) largest = std::max(largest, std::fabs(float(half(half::FromBits, bits))));
+    EXPECT_GE(largest, 16384.0f) << c.name;
+    EXPECT_LT(largest, 32768.0f) << c.name;
+  }
+  for (const int e : {40, -40}) {
+    spectral::SpectralImage scaled = img;
+    for (auto& layer : scaled.lights)
+      for (float& v : layer.data) v = std::ldexp(v, e);
+    const CompressedTransport ts = compress_transport(scaled, all);
+    for (std::size_t l = 0; l < t.lights.size(); ++l) {
+      EXPECT_EQ(ts.lights[l].k, t.lights[l].k);
+      EXPECT_EQ(ts.lights[l].coefficients, t.lights[l].coefficients) << "e = " << e;
+      const Eigen::MatrixXf expected = t.lights[l].basis * std::ldexp(1.0f, e);
+      EXPECT_EQ(ts.lights[l].basis, expected) << "e = " << e;
+    }
+  }
 }
 
 TEST(CompressedRelight, EqualsExactRelightOfTheReconstructedSpectra) {
   const auto img = smooth_image(40, 30, 16);
   const CompressedTransport t = compress_transport(img);
-  spectral::SpectralImage back = img;
-  for (std::size_t l = 0; l < t.lights.size(); ++l) {
-    const CompressedLayer& c = t.lights[l];
+  for (const CompressedLayer& c : t.lights) {
     EXPECT_GE(c.k, 1);
     EXPECT_LT(c.k, 16) << "smooth spectra compress";
     ASSERT_EQ(c.errors.size(), 4u);
     for (const auto& e : c.errors) EXPECT_LE(e.percentile, 0.5) << c.name << " " << e.light;
-    for (std::size_t p = 0; p < img.pixel_count(); ++p) {
-      const Eigen::VectorXf s = c.basis * Eigen::Map<const Eigen::VectorXf>(c.coefficients.data() + p * c.k, c.k);
-      for (int i = 0; i < 16; ++i) back.lights[l].data[p * 16 + static_cast<std::size_t>(i)] = s[i];
-    }
   }
+  const spectral::SpectralImage back = reconstructed(img, t);
   RelightOptions opts;
   opts.exposure_ev = 0.5;
   opts.adapt_to_d65 = true;
@@ -128,13 +196,7 @@ TEST(DisplayEncoder8, BakedSrgbWritesWhatAnEightBitPngHolds) {
   std::vector<std::uint8_t> png(fast.size());
   ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, png.data()));
   in->close();
-  std::size_t differ = 0;
-  int worst = 0;
-  for (std::size_t i = 0; i < png.size(); ++i) {
-    const int d = std::abs(int{png[i]} - int{fast[i]});
-    worst = std::max(worst, d);
-    differ += d != 0;
-  }
+  const auto [differ, worst] = code_diff(png, fast);
   EXPECT_LE(worst, 1);
   EXPECT_LE(differ, png.size() / 1000) << differ << " of " << png.size() << " values differ by 1";
   fs::remove_all(dir);
@@ -193,18 +255,62 @@ TEST(DisplayEncoder8, FusedFrameEqualsRelightThenEncode) {
       relight_compressed_to_display8(t, m, encoder, fused1.data());
     }
     EXPECT_EQ(fused, fused1) << "independent of the thread count";
-    std::size_t differ = 0;
-    int worst = 0;
-    for (std::size_t i = 0; i < ref.size(); ++i) {
-      const int d = std::abs(int{ref[i]} - int{fused[i]});
-      worst = std::max(worst, d);
-      differ += d != 0;
-    }
+    const auto [differ, worst] = code_diff(ref, fused);
     EXPECT_LE(worst, 1);
     EXPECT_LE(differ, ref.size() / 1000) << differ << " of " << ref.size();
     std::size_t saturated = 0;
     for (const std::uint8_t v : fused) saturated += v == 255;
     EXPECT_LT(saturated, fused.size()) << "not all white";
+  }
+}
+
+// The first k coefficients of each layer of a k = n transport (its basis' first k columns).
+CompressedTransport truncated(const CompressedTransport& full, int k) {
+  CompressedTransport t = full;
+  for (CompressedLayer& c : t.lights) {
+    const auto n = static_cast<std::size_t>(c.k);
+    std::vector<std::uint16_t> kept(full.pixel_count() * static_cast<std::size_t>(k));
+    for (std::size_t p = 0; p < full.pixel_count(); ++p)
+      std::copy_n(c.coefficients.begin() + static_cast<std::ptrdiff_t>(p * n), k, kept.begin() + static_cast<std::ptrdiff_t>(p * static_cast<std::size_t>(k)));
+    c.coefficients = std::move(kept);
+    c.basis = Eigen::MatrixXf(c.basis.leftCols(k));
+    c.k = k;
+  }
+  return t;
+}
+
+// Every k path of the fused row (de-interleaved half loads for k = 1..4, a converted row and
+// gathers beyond) on every SIMD target this machine runs, against relight_compressed_into + encode:
+// the same codes but for float rounding (FMA or not, the folded matrix).
+TEST(DisplayEncoder8, FusedFrameOnEverySimdTargetAndEveryK) {
+  const auto img = smooth_image(203, 61, 16);  // a width that is no multiple of any SIMD width
+  spectral::BasisCriterion all;
+  all.max_delta_e = -1.0;
+  const CompressedTransport full = compress_transport(img, all);
+  const spectral::DisplayTransform display(spectral::DisplayOptions{});
+  const DisplayEncoder8 encoder(display);
+  ASSERT_FALSE(encoder.small_lut(0).empty());
+  const RelightMatrix m(img.bins, {parse_light_spec("D65*0.8"), parse_light_spec("F11")}, {});
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  ASSERT_FALSE(targets.empty());
+  for (const int k : {1, 2, 3, 4, 5, 16}) {
+    const CompressedTransport t = truncated(full, k);
+    std::vector<float> xyz(3 * img.pixel_count());
+    relight_compressed_into(t, m, xyz.data());
+    std::vector<std::uint8_t> ref(xyz.size()), fused(xyz.size());
+    encoder.encode(xyz.data(), img.pixel_count(), ref.data());
+    for (const std::int64_t target : targets) {
+      hwy::SetSupportedTargetsForTest(target);
+      std::fill(fused.begin(), fused.end(), std::uint8_t{0});
+      relight_compressed_to_display8(t, m, encoder, fused.data());
+      const auto [differ, worst] = code_diff(ref, fused);
+      EXPECT_LE(worst, 1) << "k = " << k << " on " << hwy::TargetName(target);
+      EXPECT_LE(differ, ref.size() / 1000) << "k = " << k << " on " << hwy::TargetName(target) << ": " << differ;
+    }
+    hwy::SetSupportedTargetsForTest(0);
+    std::size_t distinct = 0;
+    for (std::size_t i = 1; i < ref.size(); ++i) distinct += ref[i] != ref[i - 1];
+    EXPECT_GT(distinct, ref.size() / 10) << "an image, not a flat colour";
   }
 }
 

@@ -10,6 +10,7 @@
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 #include <gtest/gtest.h>
+#include <half.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -59,6 +60,7 @@ SpectralImage image_with_coefficients(int lights, int k) {
     const Eigen::MatrixXf b = basis_columns(basis, k);
     layer.coefficients.basis.assign(b.data(), b.data() + b.size());
     layer.coefficients.values = project_coefficients(basis, k, layer.data.data(), img.pixel_count());
+    for (float& v : layer.coefficients.values) v = half(v);  // what the file holds (as compress stores them)
     layer.coefficients.errors = {{"D65", 0.125, 0.5}, {"A", 0.25, 0.75}};
     img.lights.push_back(std::move(layer));
   }
@@ -251,6 +253,7 @@ TEST_F(CoefficientsExr, ReaderRefusesAMissingBasisOrAGap) {
     in.setFrameBuffer(fb);
     in.readPixels(dw.min.y, dw.max.y);
     edit(header, values);
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) it.channel().type = Imf::FLOAT;
     Imf::OutputFile o(file(out).c_str(), header);
     Imf::FrameBuffer ofb;
     for (auto& [name, v] : values)
@@ -275,6 +278,41 @@ TEST_F(CoefficientsExr, ReaderRefusesAMissingBasisOrAGap) {
       EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
     }
   }
+}
+
+// The coefficient channels are half: float values are rounded to the nearest half on write (the
+// checksum covers the rounded values, so the file verifies), and values half cannot hold are refused
+// before anything is written.
+TEST_F(CoefficientsExr, ChannelsAreHalfRoundedOnWriteAndRangeChecked) {
+  SpectralImage img = image_with_coefficients(2, 3);
+  img.lights[1].coefficients.values[7] = 0.1f;  // not a half: rounds to 0.0999755859375
+  write_spectral_exr(file("h.exr"), img);
+  {
+    Imf::InputFile in(file("h.exr").c_str());
+    int coefficient_channels = 0;
+    for (auto it = in.header().channels().begin(); it != in.header().channels().end(); ++it) {
+      if (std::string(it.name()).find("coef.") == std::string::npos) continue;
+      ++coefficient_channels;
+      EXPECT_EQ(it.channel().type, Imf::HALF) << it.name();
+    }
+    EXPECT_EQ(coefficient_channels, 6);
+  }
+  const SpectralImage back = read_spectral_exr(file("h.exr"), with_coefficients());  // checksum verified
+  EXPECT_EQ(back.lights[1].coefficients.values[7], 0.0999755859375f);
+  EXPECT_EQ(back.lights[0].coefficients.values, img.lights[0].coefficients.values);
+  EXPECT_EQ(back.lights[0].data, img.lights[0].data) << "the bins stay float";
+
+  img.lights[0].coefficients.values[3 * 13 + 2] = 70000.0f;  // pixel (1, 1), coefficient 2
+  try {
+    write_spectral_exr(file("big.exr"), img);
+    FAIL() << "a coefficient beyond half's range was written";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("coefficients of light \"key\""), std::string::npos) << m;
+    EXPECT_NE(m.find("pixel (1, 1), coefficient 2"), std::string::npos) << m;
+    EXPECT_NE(m.find("65504"), std::string::npos) << m;
+  }
+  EXPECT_FALSE(fs::exists(file("big.exr")));
 }
 
 }  // namespace

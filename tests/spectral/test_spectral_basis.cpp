@@ -142,5 +142,33 @@ TEST(SpectralBasis, RefusesBadShapes) {
   EXPECT_THROW(basis_errors(basis, 1, data.data(), 1, BinLayout::linear(400.0, 700.0, 8)), InputError);
 }
 
+// reconstruction_errors of the projected coefficients are basis_errors (the same statistics of the
+// same reconstruction, within rounding), and a perturbed reconstruction is measured as such.
+TEST(SpectralBasis, ReconstructionErrorsOfTheProjectionAreTheBasisErrors) {
+  const std::size_t pixels = 1200;
+  const auto data = mixture_image(pixels, 5, 0.01, 9);
+  const SpectralBasis basis = spectral_basis(data.data(), pixels, kBins);
+  for (const int k : {2, 4}) {
+    std::vector<float> c = project_coefficients(basis, k, data.data(), pixels);
+    const auto expected = basis_errors(basis, k, data.data(), pixels, layout());
+    const auto got = reconstruction_errors(basis_columns(basis, k), c.data(), data.data(), pixels, layout());
+    ASSERT_EQ(got.size(), expected.size());
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i].light, expected[i].light);
+      EXPECT_NEAR(got[i].percentile, expected[i].percentile, 1e-3 * expected[i].percentile + 1e-6) << got[i].light;
+      EXPECT_NEAR(got[i].max, expected[i].max, 1e-3 * expected[i].max + 1e-6) << got[i].light;
+    }
+  }
+  // Exact at k = n; 10 % too bright everywhere is not.
+  std::vector<float> c = project_coefficients(basis, kBins, data.data(), pixels);
+  for (const BasisError& e : reconstruction_errors(basis_columns(basis, kBins), c.data(), data.data(), pixels, layout()))
+    EXPECT_LT(e.max, 0.01) << e.light;
+  for (float& v : c) v *= 1.1f;
+  for (const BasisError& e : reconstruction_errors(basis_columns(basis, kBins), c.data(), data.data(), pixels, layout()))
+    EXPECT_GT(e.percentile, 1.0) << e.light;
+  EXPECT_THROW(reconstruction_errors(Eigen::MatrixXf::Zero(kBins + 1, 2), data.data(), data.data(), pixels, layout()),
+               InputError);
+}
+
 }  // namespace
 }  // namespace prizma::spectral

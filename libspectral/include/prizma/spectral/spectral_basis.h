@@ -53,6 +53,12 @@ struct BasisCriterion {
 // ΔE00 between the relit exact and relit reconstructed spectra, CIELAB relative to the light's white
 // (XYZ of T = 1, Y = 1), at criterion.percentile and the maximum.
 
+// The same statistics for a reconstruction as stored, t̂_p = basis·c_p: `basis` n×k (any columns),
+// `coefficients` pixels·k floats, pixel-major (e.g. the half values a file holds, as floats).
+std::vector<BasisError> reconstruction_errors(const Eigen::MatrixXf& basis, const float* coefficients, const float* data,
+                                              std::size_t pixels, const BinLayout& bins,
+                                              const BasisCriterion& criterion = {});
+
 struct BasisChoice {
   int k = 0;
   std::vector<BasisError> errors;  // per test light, at the chosen k

@@ -19,13 +19,28 @@
 
 namespace prizma::relight {
 
+// One light layer: t_p ≈ basis·c_p. The coefficients are IEEE binary16 ("half", what the spectral
+// EXR's coefficient channels hold): half the bytes of float for the relight to read. To keep half's
+// precision whatever the transport's level, the layer is scaled by a power of two 2^e chosen so that
+// the largest |c| lies in [16384, 32768) (half's largest finite is 65504): the coefficients are
+// c/2^e and the basis columns, orthogonal, each have length 2^e (exact in float either way).
 struct CompressedLayer {
   std::string name;
   int k = 0;
-  Eigen::MatrixXf basis;                     // n×k, orthonormal columns
-  std::vector<float> coefficients;           // pixels·k, pixel-major: c(p, j) = coefficients[p·k + j]
-  std::vector<spectral::BasisError> errors;  // at k, under the criterion's lights (empty if unknown)
+  Eigen::MatrixXf basis;                     // n×k, orthogonal columns of length 2^e
+  std::vector<std::uint16_t> coefficients;   // pixels·k half bits, pixel-major: c(p, j) at [p·k + j]
+  std::vector<spectral::BasisError> errors;  // at k, under the criterion's lights, of these half
+                                             // coefficients (empty if unknown)
 };
+
+// The layer from float coefficients (pixels·k, pixel-major) and their n×k basis (orthonormal from
+// the projection; as stored when read from a file): the power-of-two scale above (1 when the
+// coefficients are already in range), then each coefficient rounded to the nearest half (ties to
+// even). Throws RuntimeError for a non-finite coefficient.
+void set_half_coefficients(CompressedLayer& layer, const Eigen::MatrixXf& basis, const std::vector<float>& coefficients);
+
+// t_p = basis·c_p of pixel p (n floats).
+Eigen::VectorXf reconstructed_spectrum(const CompressedLayer& layer, std::size_t p);
 
 struct CompressedTransport {
   int width = 0;
@@ -35,12 +50,15 @@ struct CompressedTransport {
   std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
 };
 
-// Per light: basis from the layer's Gram matrix, k by choose_basis_size, coefficients by projection.
+// Per light: basis from the layer's Gram matrix, k by choose_basis_size, coefficients by projection,
+// stored as half (set_half_coefficients); the errors are those of the half coefficients, and k grows
+// by one while half rounding takes an error past the criterion's bound.
 CompressedTransport compress_transport(const spectral::SpectralImage& image,
                                        const spectral::BasisCriterion& criterion = {});
 
 // The coefficients a spectral EXR carries (SpectralImage::has_coefficients; read with
-// ExrReadOptions::read_coefficients), moved out of the image's layers (their k, basis and errors stay).
+// ExrReadOptions::read_coefficients), moved out of the image's layers as half (their k, basis and
+// errors stay; set_half_coefficients, so a file of float coefficients is scaled and rounded here).
 // Throws InputError (naming `source`) when a layer's sizes disagree.
 CompressedTransport take_coefficients(spectral::SpectralImage& image, const std::string& source);
 
