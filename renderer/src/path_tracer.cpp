@@ -346,13 +346,35 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
   if (!(t_exit > t_enter)) return;
   const std::int64_t step_limit = s.counters.shadow_steps + kMaxPathSteps;
   const CellControl* control = nullptr;  // the current cell's
-  bool any_control = false;
-  float t_res_max = 1.0f;    // the largest lane of T (the residual product)
-  float control_max = 1.0f;  // exp(−min τ): the largest lane of exp(−τ)
-  // After a step, the roulette on a bound of the largest transmittance, T_max·exp(−min τ) (none
-  // between cells: crossing a homogeneous cell is exact and costs no random number); false: stopped.
+  // The controls' optical depth τ_i = Σ_cells d_c·ℓ·σt,i: while consecutive cells share a control
+  // material m, the scalar D = Σ d_c·ℓ (one multiply-add per cell), added to the lanes as D·σt_m
+  // when the material changes and at the end.
+  std::uint16_t run_material = CellControl::kNone;
+  float run_depth = 0.0f;      // D of the current run
+  float run_sigma_min = 0.0f;  // the least lane of σt_m
+  bool any_control = false;    // tau holds a flushed run
+  float tau_min = 0.0f;        // the least lane of tau
+  auto flush = [&]() {
+    if (run_material == CellControl::kNone || !(run_depth > 0.0f)) return;
+    const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, run_material);
+    if (any_control)
+      tau += sigma_t * run_depth;
+    else
+      tau = sigma_t * run_depth;
+    any_control = true;
+    tau_min = tau[0];
+    for (int i = 1; i < n; ++i) tau_min = std::min(tau_min, tau[i]);
+    run_depth = 0.0f;
+  };
+  float t_res_max = 1.0f;  // the largest lane of T (the residual product)
+  // After a step, the roulette on a bound of the largest transmittance, T_max·exp(−min τ) with
+  // min τ ≥ tau_min + D·σt_min (none between cells: crossing a homogeneous cell is exact and costs
+  // no random number); false: stopped.
   auto roulette = [&]() {
-    if (!(t_res_max * control_max < kTransmittanceRrThreshold)) return true;
+    if (!(t_res_max < kTransmittanceRrThreshold)) {
+      const float depth_lo = tau_min + run_depth * run_sigma_min;
+      if (!(depth_lo > 0.0f) || !(t_res_max * std::exp(-depth_lo) < kTransmittanceRrThreshold)) return true;
+    }
     if (rng.uniform() < kTransmittanceRrStop) {
       T = 0.0f;
       return false;
@@ -367,17 +389,15 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
     mu = control->residual;
     const std::uint16_t m = control->material;
     if (m == CellControl::kNone) return true;
-    if (s.cache.stamp[m] != s.cache.path_id) evaluate_material(m, s);
-    const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
-    const float k = control->density * static_cast<float>(seg.t1 - seg.t0);
-    if (any_control)
-      tau += sigma_t * k;
-    else
-      tau = sigma_t * k;
-    any_control = true;
-    float tau_min = tau[0];
-    for (int i = 1; i < n; ++i) tau_min = std::min(tau_min, tau[i]);
-    control_max = std::exp(-tau_min);
+    if (m != run_material) {
+      flush();
+      run_material = m;
+      if (s.cache.stamp[m] != s.cache.path_id) evaluate_material(m, s);
+      const float* st = s.cache.sigma_t.data() + static_cast<std::size_t>(m) * n;
+      run_sigma_min = st[0];
+      for (int i = 1; i < n; ++i) run_sigma_min = std::min(run_sigma_min, st[i]);
+    }
+    run_depth += control->density * static_cast<float>(seg.t1 - seg.t0);
     return true;
   };
   const bool reached = sample_segments(m_grid, ray, t_enter, t_exit, rng, s.counters.majorant_cells, on_segment,
@@ -415,7 +435,9 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
     t_res_max = T.max();
     return roulette();
   });
-  if (reached && any_control) T *= lane_map([](float x) { return std::exp(-x); }, ConstLanes<kLanes>(tau));
+  if (!reached) return;
+  flush();
+  if (any_control) T *= lane_map([](float x) { return std::exp(-x); }, ConstLanes<kLanes>(tau));
 }
 
 void PathTracer::estimate_transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
