@@ -13,6 +13,15 @@ namespace prizma::render {
 
 namespace {
 float majorant_over_values(const Medium& medium, const std::vector<float>& sigma_t_max, float v_lo, float v_hi);
+CellControl control_over_values(const Medium& medium, const std::vector<float>& sigma_t_max, float v_lo, float v_hi);
+
+// μ̄r for a cell of one material whose densities lie in [d_c, d_max]: at a point of density d the
+// tracer computes (d − d_c)·σt(λ) in float, at most (d_max − d_c)·σt_max by monotone rounding; one
+// float ulp up as the majorants (0 stays 0: a homogeneous cell takes no steps).
+float residual_majorant(float d_c, float d_max, float sigma_t_max) {
+  const float r = (d_max - d_c) * sigma_t_max;
+  return r > 0.0f ? std::nextafter(r, std::numeric_limits<float>::infinity()) : 0.0f;
+}
 
 // Runs body(cy, cz) for every row of cells (a y, z pair; the x cells of a row are the body's), rows
 // in parallel. Every cell's majorant is computed from the volume alone and written by the one task
@@ -39,6 +48,7 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
     m_cell_size[a] = voxel * span[a];
   }
   m_majorant.assign(static_cast<std::size_t>(m_cells[0]) * m_cells[1] * m_cells[2], 0.0f);
+  m_control.assign(m_majorant.size(), CellControl{});
   bool blocks_fit = !medium.block_range.empty();
   for (int a = 0; a < 3; ++a) blocks_fit = blocks_fit && (span[a] % Volume::kBlockVoxels == 0 || m_cells[a] == 1);
   if (blocks_fit) {
@@ -48,20 +58,45 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
   } else {
     for_each_cell_row(m_cells, [&](int cy, int cz) {
       const int z1 = std::min(d[2], (cz + 1) * span[2]), y1 = std::min(d[1], (cy + 1) * span[1]);
-      float* row = m_majorant.data() + (static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0];
+      const std::size_t row0 = (static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0];
+      float* row = m_majorant.data() + row0;
+      // Per cell of the row: its one material (kNone until a voxel is seen; `mixed` once a second
+      // material or an empty voxel is), and its least and largest density.
+      std::vector<CellControl> ctl(static_cast<std::size_t>(m_cells[0]));
+      std::vector<float> d_max(ctl.size(), 0.0f);
+      std::vector<char> mixed(ctl.size(), 0);
+      for (auto& c : ctl) c.density = std::numeric_limits<float>::infinity();
       for (int z = cz * span[2]; z < z1; ++z)
         for (int y = cy * span[1]; y < y1; ++y)
           for (int x = 0; x < d[0]; ++x) {
             const std::size_t v = (static_cast<std::size_t>(z) * d[1] + y) * d[0] + x;
             const std::uint16_t m = medium.material[v];
-            if (m == Medium::kEmpty) continue;
-            float& cell = row[x / span[0]];
-            cell = std::max(cell, medium.density[v] * sigma_t_max[m]);
+            const int cx = x / span[0];
+            const float dv = medium.density[v];
+            if (m == Medium::kEmpty || !(dv > 0.0f)) {  // empty space: σt = 0, no positive control
+              mixed[cx] = 1;
+              continue;
+            }
+            float& cell = row[cx];
+            cell = std::max(cell, dv * sigma_t_max[m]);
+            CellControl& c = ctl[cx];
+            if (c.material != m) mixed[cx] = mixed[cx] || c.material != CellControl::kNone;
+            c.material = m;
+            c.density = std::min(c.density, dv);
+            d_max[cx] = std::max(d_max[cx], dv);
           }
+      for (std::size_t cx = 0; cx < ctl.size(); ++cx) {
+        if (mixed[cx] || ctl[cx].material == CellControl::kNone) continue;
+        ctl[cx].residual = residual_majorant(ctl[cx].density, d_max[cx], sigma_t_max[ctl[cx].material]);
+        m_control[row0 + cx] = ctl[cx];
+      }
     });
   }
   if (!medium.clip.empty()) zero_clipped_cells(medium);
   for (float mu : m_majorant) m_max = std::max(m_max, mu);
+  // Cells without a control: plain ratio tracking against the majorant.
+  for (std::size_t k = 0; k < m_control.size(); ++k)
+    if (m_control[k].material == CellControl::kNone) m_control[k].residual = m_majorant[k];
 }
 
 namespace {
@@ -80,6 +115,27 @@ float majorant_over_values(const Medium& medium, const std::vector<float>& sigma
   }
   if (mu > 0.0f) mu = std::nextafter(mu, std::numeric_limits<float>::infinity());
   return mu;
+}
+
+// The control of a cell whose points take values in [v_lo, v_hi] (finite): when the first rule
+// that meets the range holds all of it (so every point classifies to its material) and its ramp's
+// least density there is > 0, d_c is that least density (the tracer's float of the ramp's double,
+// which rounding keeps ≥ float(least)); otherwise none.
+CellControl control_over_values(const Medium& medium, const std::vector<float>& sigma_t_max, float v_lo, float v_hi) {
+  CellControl c;
+  if (!(v_lo <= v_hi)) return c;
+  for (const MaterialRule& r : medium.rules) {
+    if (!(std::max<double>(r.value_lo, v_lo) <= std::min<double>(r.value_hi, v_hi))) continue;
+    if (!(r.value_lo <= v_lo && v_hi <= r.value_hi)) return c;
+    const auto d_c = static_cast<float>(r.density.min_over(v_lo, v_hi));
+    if (!(d_c > 0.0f)) return c;
+    const auto d_max = static_cast<float>(r.density.max_over(v_lo, v_hi));
+    c.material = static_cast<std::uint16_t>(r.material);
+    c.density = d_c;
+    c.residual = residual_majorant(d_c, d_max, sigma_t_max[static_cast<std::size_t>(r.material)]);
+    return c;
+  }
+  return c;
 }
 
 }  // namespace
@@ -118,16 +174,22 @@ void MajorantGrid::build_from_blocks(const Medium& medium, const std::vector<flo
 void MajorantGrid::zero_clipped_cells(const Medium& medium) {
   // A cell whose every corner lies on the removed side of one clip plane holds no medium (the side
   // is a half-space, so the whole box does): its majorant 0 stays a bound and costs one DDA step.
+  // A cell that some plane cuts holds empty points, so it keeps no control.
   for_each_cell_row(m_cells, [&](int cy, int cz) {
       for (int cx = 0; cx < m_cells[0]; ++cx) {
+        const std::size_t k = (static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx;
         const Eigen::Vector3d lo = m_min + Eigen::Vector3d(cx, cy, cz).cwiseProduct(m_cell_size);
         const Eigen::Vector3d hi = lo + m_cell_size;
         for (const ClipPlane& p : medium.clip) {
-          // The box's corner with the least dot(normal, ·).
-          double least = 0.0;
-          for (int a = 0; a < 3; ++a) least += p.normal[a] * (p.normal[a] >= 0.0 ? lo[a] : hi[a]);
+          // The box's corners with the least and the largest dot(normal, ·).
+          double least = 0.0, largest = 0.0;
+          for (int a = 0; a < 3; ++a) {
+            least += p.normal[a] * (p.normal[a] >= 0.0 ? lo[a] : hi[a]);
+            largest += p.normal[a] * (p.normal[a] >= 0.0 ? hi[a] : lo[a]);
+          }
+          if (largest > p.offset) m_control[k] = CellControl{};
           if (least > p.offset) {
-            m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] = 0.0f;
+            m_majorant[k] = 0.0f;
             break;
           }
         }
@@ -153,17 +215,22 @@ void MajorantGrid::build_trilinear(const Medium& medium, const std::vector<float
           hi[a] = std::min(d[a] - 1, c[a] * span[a] + span[a]);
         }
         float v_lo = std::numeric_limits<float>::infinity(), v_hi = -v_lo;
+        bool any_empty = false;
         for (int z = lo[2]; z <= hi[2]; ++z)
           for (int y = lo[1]; y <= hi[1]; ++y) {
             const float* row = medium.value.data() + (static_cast<std::size_t>(z) * d[1] + y) * d[0];
             for (int x = lo[0]; x <= hi[0]; ++x) {
-              if (!std::isfinite(row[x])) continue;  // a point touching it is empty space
+              if (!std::isfinite(row[x])) {  // a point touching it is empty space
+                any_empty = true;
+                continue;
+              }
               v_lo = std::min(v_lo, row[x]);
               v_hi = std::max(v_hi, row[x]);
             }
           }
-        const float mu = majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
-        m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] = mu;
+        const std::size_t k = (static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx;
+        m_majorant[k] = majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
+        if (!any_empty) m_control[k] = control_over_values(medium, sigma_t_max, v_lo, v_hi);
       }
   });
 }

@@ -62,6 +62,13 @@ double DensityRamp::max_over(double lo, double hi) const {
   return m;
 }
 
+double DensityRamp::min_over(double lo, double hi) const {
+  double m = std::min(eval(lo), eval(hi));
+  for (std::size_t k = 0; k < values.size(); ++k)
+    if (values[k] > lo && values[k] < hi) m = std::min(m, densities[k]);
+  return m;
+}
+
 double ValueNormalisation::to_unit(double v) const {
   const double t = (v - min) / (max - min);
   return std::clamp(t, 0.0, 1.0);

@@ -234,4 +234,41 @@ TEST(MajorantGrid, ParallelNearestBuildHoldsEachCellsVoxelMaximum) {
   EXPECT_TRUE(same_bits(cells_of(grid), want));
 }
 
+TEST(MajorantGrid, CellControlsAreTheLeastDensityOfOneMaterial) {
+  // Residual ratio tracking's controls: a cell of one material gets its least density and the
+  // residual (largest − least)·σt_max (one ulp up); a cell with an empty voxel or a second
+  // material gets none, its residual the majorant.
+  Medium m = medium_16();
+  m.materials.push_back(testing::grey_material(0.5, 3.0));
+  auto fill = [&](int cx, int cy, int cz, auto density_of) {
+    for (int z = 8 * cz; z < 8 * cz + 8; ++z)
+      for (int y = 8 * cy; y < 8 * cy + 8; ++y)
+        for (int x = 8 * cx; x < 8 * cx + 8; ++x) {
+          const std::size_t v = (static_cast<std::size_t>(z) * 16 + y) * 16 + x;
+          m.material[v] = 0;
+          m.density[v] = density_of(x, y, z);
+        }
+  };
+  fill(0, 0, 0, [](int x, int, int) { return 1.0f + 0.25f * static_cast<float>(x % 5); });  // 1 … 2
+  fill(1, 0, 0, [](int, int, int) { return 0.5f; });                                         // homogeneous
+  fill(0, 1, 0, [](int, int, int) { return 1.0f; });
+  m.material[(static_cast<std::size_t>(0) * 16 + 8) * 16 + 0] = Medium::kEmpty;  // one empty voxel
+  fill(0, 0, 1, [](int, int, int) { return 1.0f; });
+  m.material[(static_cast<std::size_t>(8) * 16 + 0) * 16 + 0] = 1;  // a second material
+  const MajorantGrid grid(m, {2.0f, 3.0f}, 8);
+  const CellControl& a = grid.control({0, 0, 0});
+  EXPECT_EQ(a.material, 0);
+  EXPECT_EQ(a.density, 1.0f);
+  EXPECT_EQ(a.residual, std::nextafter(2.0f, 3.0f));  // (2 − 1)·2, one ulp up
+  const CellControl& b = grid.control({1, 0, 0});
+  EXPECT_EQ(b.material, 0);
+  EXPECT_EQ(b.density, 0.5f);
+  EXPECT_EQ(b.residual, 0.0f);  // homogeneous: no steps
+  for (const auto& c : {std::array<int, 3>{0, 1, 0}, std::array<int, 3>{0, 0, 1}, std::array<int, 3>{1, 1, 1}}) {
+    EXPECT_EQ(grid.control(c).material, CellControl::kNone);
+    EXPECT_EQ(grid.control(c).residual, grid.majorant(c[0], c[1], c[2]));
+  }
+  EXPECT_FLOAT_EQ(grid.majorant(0, 0, 1), 3.0f);
+}
+
 }  // namespace prizma::render

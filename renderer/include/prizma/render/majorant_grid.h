@@ -5,14 +5,28 @@
 // cell's and its neighbours' voxel values classifies to). Free-flight and transmittance sampling walk the cells with a 3-D DDA
 // (Amanatides & Woo 1987), so cells whose majorant is 0 cost one step. With one cell it is the single
 // global majorant (settings.use_majorant_grid = false).
+//
+// Each cell also holds the control of residual ratio tracking (Novák, Georgiev, Hanika, Jarosz
+// 2014): where every point of the cell holds one material m with density ≥ d_c > 0, the control
+// extinction is σc(λ) = d_c·σt_m(λ) per lane (the path's wavelengths), and the residual majorant
+// μ̄r = (d_max − d_c)·max σt_m bounds σt − σc there; a homogeneous cell has μ̄r = 0.
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "prizma/render/camera.h"
 #include "prizma/render/scene.h"
 
 namespace prizma::render {
+
+// A cell's control: material kNone = no control (σc = 0 and residual = the cell's majorant).
+struct CellControl {
+  static constexpr std::uint16_t kNone = 0xffff;  // = Medium::kEmpty
+  float residual = 0.0f;  // μ̄r ≥ σt − σc at every point of the cell and wavelength of the render
+  float density = 0.0f;   // d_c: σc(λ) = d_c·σt_material(λ)
+  std::uint16_t material = kNone;
+};
 
 class MajorantGrid {
  public:
@@ -27,6 +41,9 @@ class MajorantGrid {
   float majorant(int cx, int cy, int cz) const {
     return m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx];
   }
+  const CellControl& control(const std::array<int, 3>& c) const {
+    return m_control[(static_cast<std::size_t>(c[2]) * m_cells[1] + c[1]) * m_cells[0] + c[0]];
+  }
   float max_majorant() const { return m_max; }
   const Eigen::Vector3d& bounds_min() const { return m_min; }
   const Eigen::Vector3d& bounds_max() const { return m_max_corner; }
@@ -40,6 +57,7 @@ class MajorantGrid {
   std::array<int, 3> m_cells{1, 1, 1};
   Eigen::Vector3d m_min{0, 0, 0}, m_max_corner{0, 0, 0}, m_cell_size{1, 1, 1};
   std::vector<float> m_majorant;
+  std::vector<CellControl> m_control;
   float m_max = 0.0f;
 };
 

@@ -15,6 +15,8 @@ struct DensityRamp {
   double eval(double value) const;
   // The largest density over values in [lo, hi] (lo ≤ hi): at the ends and the points inside.
   double max_over(double lo, double hi) const;
+  // The least density over values in [lo, hi] (lo ≤ hi), likewise.
+  double min_over(double lo, double hi) const;
 };
 
 // Voxels whose raw value v satisfies value_lo ≤ v ≤ value_hi get `material` (first matching rule).

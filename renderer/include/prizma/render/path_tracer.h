@@ -63,6 +63,7 @@ struct MaterialCache {
 struct PathWork {
   std::vector<float> weight;         // [lanes] path throughput
   std::vector<float> transmittance;  // [lanes] ratio tracking
+  std::vector<float> optical_depth;  // [lanes] ratio tracking: the controls' ∫ σc ds
   std::vector<float> phase;          // [lanes]
   std::vector<float> sigma_a, sigma_s, sigma_n;  // [lanes] at the current collision
   std::vector<float> zero_g;         // [lanes] g = 0: fluorescence's isotropic re-emission
@@ -108,6 +109,11 @@ class PathTracer {
   // environment-map lights; not the uniform environment nor emission), in scene order: their
   // indices in scene.lights.
   const std::vector<int>& directional_lights() const { return m_directional_index; }
+  // The transmittance estimate next-event estimation uses (residual ratio tracking), from origin
+  // along dir up to t_max at the wavelengths in scratch.in.lambda_nm, per lane into
+  // scratch.work.transmittance (for tests and benches).
+  void estimate_transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max, Rng& rng,
+                              PathScratch& scratch) const;
   const MajorantGrid& grid() const { return m_grid; }
   // Index in scene.lights of the emission light (Light::emission), or −1.
   int emission_light() const { return m_emission_light; }
