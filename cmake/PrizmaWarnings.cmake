@@ -1,4 +1,5 @@
-# Warning flags for Prizma's own targets: prizma_set_warnings(target).
+# Warning flags for Prizma's own targets, and the sanitizer trees' run-time defaults in their
+# executables: prizma_set_warnings(target).
 function(prizma_set_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Woverloaded-virtual)
   # GCC 12 at -O3 (Release) reports -Wrestrict inside libstdc++'s std::string operator+ where no
@@ -9,6 +10,11 @@ function(prizma_set_warnings target)
   endif()
   if(PRIZMA_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  # Sanitizer trees: every executable carries the sanitizers' run-time defaults (the file says why).
+  get_target_property(type ${target} TYPE)
+  if((PRIZMA_SANITIZE OR PRIZMA_FUZZ) AND type STREQUAL "EXECUTABLE")
+    target_sources(${target} PRIVATE ${PROJECT_SOURCE_DIR}/cmake/sanitizer_options.cpp)
   endif()
 endfunction()
 

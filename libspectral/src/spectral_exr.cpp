@@ -847,7 +847,7 @@ std::string reencoding_signs(const Imf::Header& h) {
 // prizma:checksum against the pixels read: v2 with the top-level layer `top` (null when the file has
 // none, or one light), v1 without it.
 void verify_checksum(const std::string& p, const Imf::Header& header, const std::string& stored,
-                     const SpectralImage& image, const std::vector<float>* top) {
+                     const SpectralImage& image, const std::vector<float>* top, const std::string& unverified_read) {
   std::string expected;
   if (stored.rfind(kChecksumScheme, 0) == 0) {
     std::uint64_t sum = light_layers_hash(image);
@@ -864,12 +864,12 @@ void verify_checksum(const std::string& p, const Imf::Header& header, const std:
   if (stored == expected) return;
   const std::string signs = reencoding_signs(header);
   if (signs.empty()) {
-    throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) +
-                            " (the file is damaged; prizma-relight --no-verify reads it anyway)");
+    throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) + " (the file is damaged; " +
+                            unverified_read + " reads it anyway)");
   }
   throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) +
                           ": the file was probably re-encoded by another tool (" + signs +
-                          "), which kept the attribute but not the exact values; prizma-relight --no-verify reads it");
+                          "), which kept the attribute but not the exact values; " + unverified_read + " reads it");
 }
 
 }  // namespace
@@ -1136,7 +1136,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
 
     // A file written with a checksum must give back exactly what was written: PIZ has no check of
     // its own, so a damaged but complete file could otherwise read as other, finite values.
-    if (stored != nullptr) verify_checksum(p, header, *stored, image, read_top ? &top : nullptr);
+    if (stored != nullptr) verify_checksum(p, header, *stored, image, read_top ? &top : nullptr, opts.unverified_read);
     detail::check_coefficients_finite(image, p);
     if (!keep_coefficients) {
       for (auto& light : image.lights) light.coefficients = LayerCoefficients{};

@@ -239,6 +239,7 @@ py::dict read_file(const std::string& path, bool verify) {
     py::gil_scoped_release release;
     spectral::ExrReadOptions opts;
     opts.verify_checksum = verify;
+    opts.unverified_read = "prizma.read(path, verify=False)";
     image = spectral::read_spectral_exr(path, opts);
   }
   return image_to_py(std::move(image));

@@ -15,41 +15,8 @@ HWY_BEFORE_NAMESPACE();
 namespace prizma::relight::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-void RelightRowSimd(const SimdLayer* layers, int layer_count, int n, std::size_t first_pixel, int width,
-                    float* out) {
-  const hn::ScalableTag<float> d;
-  const std::size_t lanes = hn::Lanes(d);
-  const std::size_t nb = static_cast<std::size_t>(n);
-  const std::size_t full = nb - nb % lanes;
-  for (int x = 0; x < width; ++x) {
-    const std::size_t p = first_pixel + static_cast<std::size_t>(x);
-    auto a0 = hn::Zero(d);
-    auto a1 = hn::Zero(d);
-    auto a2 = hn::Zero(d);
-    float t0 = 0.0f, t1 = 0.0f, t2 = 0.0f;
-    for (int l = 0; l < layer_count; ++l) {
-      const float* HWY_RESTRICT w = layers[l].weights;
-      const float* HWY_RESTRICT t = layers[l].transport + p * nb;
-      std::size_t i = 0;
-      for (; i < full; i += lanes) {
-        const auto v = hn::LoadU(d, t + i);
-        a0 = hn::MulAdd(hn::LoadU(d, w + i), v, a0);
-        a1 = hn::MulAdd(hn::LoadU(d, w + nb + i), v, a1);
-        a2 = hn::MulAdd(hn::LoadU(d, w + 2 * nb + i), v, a2);
-      }
-      for (; i < nb; ++i) {
-        t0 += w[i] * t[i];
-        t1 += w[nb + i] * t[i];
-        t2 += w[2 * nb + i] * t[i];
-      }
-    }
-    out[3 * x + 0] = hn::GetLane(hn::SumOfLanes(d, a0)) + t0;
-    out[3 * x + 1] = hn::GetLane(hn::SumOfLanes(d, a1)) + t1;
-    out[3 * x + 2] = hn::GetLane(hn::SumOfLanes(d, a2)) + t2;
-  }
-}
-
-// The same loop over terms that each have their own value count (relight_simd.h, SimdTerm).
+// out[3x + c] = Σ_t Σ_j w_t[c·n_t + j]·v_t[(first_pixel + x)·n_t + j] (relight_simd.h, SimdTerm): per
+// pixel, three vector accumulators over every term's full vectors, a scalar sum over each tail.
 void RelightRowTermsSimd(const SimdTerm* terms, int term_count, std::size_t first_pixel, int width, float* out) {
   const hn::ScalableTag<float> d;
   const std::size_t lanes = hn::Lanes(d);
@@ -89,16 +56,10 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace prizma::relight::detail {
 
-HWY_EXPORT(RelightRowSimd);
 HWY_EXPORT(RelightRowTermsSimd);
 
 void relight_row_terms_simd(const SimdTerm* terms, int term_count, std::size_t first_pixel, int width, float* out) {
   HWY_DYNAMIC_DISPATCH(RelightRowTermsSimd)(terms, term_count, first_pixel, width, out);
-}
-
-void relight_row_simd(const SimdLayer* layers, int layer_count, int n, std::size_t first_pixel, int width,
-                      float* out) {
-  HWY_DYNAMIC_DISPATCH(RelightRowSimd)(layers, layer_count, n, first_pixel, width, out);
 }
 
 std::vector<std::string> relight_simd_targets() {

@@ -51,18 +51,9 @@ endif()
 
 if(TARGET prizma-metamer AND TARGET prizma-render AND TARGET prizma-relight)
   get_filename_component(_prizma_scripts ${PRIZMA_E2E_DIR}/../../scripts ABSOLUTE)
-  # Sanitizer trees: no leak check in the demos. They run dozens of PNG writes through the dlopen'd
-  # image module, and LeakSanitizer's own tracer crashes at exit now and then after one (signal 11
-  # in the tracer, "LeakSanitizer has encountered a fatal error"; the same crash as
-  # outputs.e2e.fsize_relight's, not understood yet). Address and UB checks stay on; the leak check
-  # stays on in every other test.
-  set(_demo_asan "")
-  if(PRIZMA_SANITIZE OR PRIZMA_FUZZ)
-    set(_demo_asan ";ASAN_OPTIONS=detect_leaks=0")
-  endif()
   foreach(demo metamerism-demo scattering-demo reveal-demo fluorescence-demo)
     add_test(NAME demo.${demo} COMMAND ${_prizma_scripts}/${demo} ${PRIZMA_E2E_WORK}/${demo} --small)
     set_tests_properties(demo.${demo} PROPERTIES LABELS demo TIMEOUT 600 ENVIRONMENT
-      "PRIZMA_RENDER=$<TARGET_FILE:prizma-render>;PRIZMA_RELIGHT=$<TARGET_FILE:prizma-relight>;PRIZMA_METAMER=$<TARGET_FILE:prizma-metamer>;PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR};MPLCONFIGDIR=${PRIZMA_E2E_WORK}/${demo}/.mpl${_demo_asan}")
+      "PRIZMA_RENDER=$<TARGET_FILE:prizma-render>;PRIZMA_RELIGHT=$<TARGET_FILE:prizma-relight>;PRIZMA_METAMER=$<TARGET_FILE:prizma-metamer>;PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR};MPLCONFIGDIR=${PRIZMA_E2E_WORK}/${demo}/.mpl")
   endforeach()
 endif()

@@ -20,23 +20,10 @@
 namespace prizma::relight {
 namespace {
 
-using spectral::BinLayout;
-
 std::vector<LightSpec> lights(const std::vector<std::string>& specs) {
   std::vector<LightSpec> out;
   for (const auto& s : specs) out.push_back(parse_light_spec(s));
   return out;
-}
-
-// 4×2 pixels, 6 bins over 400–700 nm, a diagonal and pairs from the two blue bins to the three red.
-spectral::SpectralImage fluorescent_image() {
-  auto img = test::make_image(4, 2, BinLayout::linear(400, 700, 6), {"uv", "sky"},
-                              [](int l, int p, int i) { return 0.05f * static_cast<float>(1 + l + p % 3 + i); });
-  img.reradiation = {{0, 3}, {0, 4}, {0, 5}, {1, 3}, {1, 4}, {1, 5}};
-  for (std::size_t l = 0; l < 2; ++l)
-    for (std::size_t k = 0; k < img.pixel_count() * 6; ++k)
-      img.lights[l].reradiation.push_back(0.02f * static_cast<float>(1 + (k * 7 + l * 3) % 11));
-  return img;
 }
 
 // ∫ f dλ by the trapezoid rule on a 0.05 nm grid.
@@ -78,7 +65,7 @@ std::vector<double> hand_xyz(const spectral::SpectralImage& img, const std::vect
 }
 
 TEST(BispectralRelight, MatchesTheHandIntegralOfMTimesE) {
-  const auto img = fluorescent_image();
+  const auto img = test::fluorescent_image();
   const auto violet = [](double l) { return std::exp(-4.0 * std::log(2.0) * (l - 420.0) * (l - 420.0) / (30.0 * 30.0)); };
   const auto flat = [](double) { return 1.0; };
   const XyzImage got = relight_image(img, RelightMatrix(img.bins, lights({"gaussian:420:30", "E*0.5"}), {}));
@@ -99,7 +86,7 @@ TEST(BispectralRelight, MatchesTheHandIntegralOfMTimesE) {
 }
 
 TEST(BispectralRelight, PrecomputedWeightsGiveTheSameImage) {
-  const auto img = fluorescent_image();
+  const auto img = test::fluorescent_image();
   RelightOptions o;
   o.exposure_ev = 1.0;
   o.adapt_to_d65 = true;
@@ -119,7 +106,7 @@ TEST(BispectralRelight, PreviewChannelsIncludeTheReradiation) {
   // The R, G, B channels written with a fluorescent image are prizma-relight's default image (each
   // light at its recorded spectrum) in linear sRGB: the diagonal and the re-radiated light, here
   // through relight_image's K path against the writer's per-pair sum (spectral_exr.cpp).
-  auto img = fluorescent_image();
+  auto img = test::fluorescent_image();
   img.info.lights_json = R"([{"name":"uv","spectrum":"LED-V1"},{"name":"sky","spectrum":"D65*0.2"}])";
   const std::filesystem::path path =
       std::filesystem::temp_directory_path() / ("prizma-bispectral-preview-" + std::to_string(::getpid()) + ".exr");

@@ -85,6 +85,20 @@ inline spectral::SpectralImage make_image(int width, int height, const spectral:
   return img;
 }
 
+// The fluorescent (bispectral) test image: 4×2 pixels, 6 bins over 400–700 nm (centres 425 … 675),
+// lights "uv" and "sky" with diagonal values 0.05·(1 + l + p % 3 + i), and pairs from the two blue
+// bins into the three red ones, {0,3}, {0,4}, {0,5}, {1,3}, {1,4}, {1,5}, with values
+// 0.02·(1 + (k·7 + 3l) % 11) (k = pixel·6 + pair).
+inline spectral::SpectralImage fluorescent_image() {
+  auto img = make_image(4, 2, spectral::BinLayout::linear(400, 700, 6), {"uv", "sky"},
+                        [](int l, int p, int i) { return 0.05f * static_cast<float>(1 + l + p % 3 + i); });
+  img.reradiation = {{0, 3}, {0, 4}, {0, 5}, {1, 3}, {1, 4}, {1, 5}};
+  for (std::size_t l = 0; l < 2; ++l)
+    for (std::size_t k = 0; k < img.pixel_count() * 6; ++k)
+      img.lights[l].reradiation.push_back(0.02f * static_cast<float>(1 + (k * 7 + l * 3) % 11));
+  return img;
+}
+
 // A fresh scratch folder per test.
 inline std::filesystem::path scratch_dir(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() /

@@ -379,15 +379,9 @@ TEST(InteractiveShell, PixelIndicesAreCheckedWithAClearError) {
 }
 
 TEST(InteractiveShell, ProbeShowsTheExcitationEmissionMapOfAFluorescentPixel) {
-  // 4×2, 6 bins over 400–700 nm (centres 425 … 675), pairs from the two blue bins into the three red
-  // ones, values 0.02·(1 + (k·7 + 3l) % 11) (k = pixel·6 + pair), as in bispectral_relight_test.
-  auto img = test::make_image(4, 2, BinLayout::linear(400, 700, 6), {"uv", "sky"},
-                              [](int l, int p, int i) { return 0.05f * static_cast<float>(1 + l + p % 3 + i); });
-  img.reradiation = {{0, 3}, {0, 4}, {0, 5}, {1, 3}, {1, 4}, {1, 5}};
-  for (std::size_t l = 0; l < 2; ++l)
-    for (std::size_t k = 0; k < img.pixel_count() * 6; ++k)
-      img.lights[l].reradiation.push_back(0.02f * static_cast<float>(1 + (k * 7 + l * 3) % 11));
-  RelightSession session(std::move(img), "fluor.exr");
+  // relight_test_util.h's fluorescent image: 6 bins over 400–700 nm (centres 425 … 675), pairs from
+  // the two blue bins into the three red ones, values 0.02·(1 + (k·7 + 3l) % 11) (k = pixel·6 + pair).
+  RelightSession session(test::fluorescent_image(), "fluor.exr");
   int failures = 0;
   const std::string text = run(session, "probe 0 0\nprobe 0 0 sky\nprobe 0 0 nope\n", &failures);
   EXPECT_EQ(failures, 1) << text;

@@ -72,6 +72,16 @@ inline Scene box_scene(const Material& material, int n = 4, int pixels = 8, std:
   return s;
 }
 
+// A box seen straight down (emergent μ = 1) through a small central window (ortho height 0.1), so
+// that every light path toward a light within 25° of the zenith leaves through the top face, lit by
+// `light` only.
+inline Scene window_scene(const Material& m, const Light& light, int pixels, std::int64_t spp) {
+  Scene s = box_scene(m, 4, pixels, spp);
+  s.camera.ortho_height = 0.1;
+  s.lights = {light};
+  return s;
+}
+
 // Fills the density with a fixed pseudo-random field in [lo, hi] (heterogeneous medium).
 inline void randomise_density(Scene& s, float lo, float hi, unsigned seed = 3) {
   std::mt19937 gen(seed);

@@ -5,15 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <functional>
 #include <iomanip>
-#include <numbers>
 #include <vector>
 
 #include "prizma/render/event_probability.h"
 #include "prizma/render/render.h"
 #include "prizma/spectral/error.h"
 #include "render_test_scenes.h"
+#include "transfer_references.h"
 
 namespace prizma::render {
 namespace {
@@ -22,71 +21,16 @@ using spectral::Spectrum;
 using testing::box_scene;
 using testing::grey_material;
 using testing::make_material;
+using testing::hg;
+using testing::HFunction;
+using testing::integrate;
+using testing::kPi;
+using testing::kSe;
 using testing::pixel_average;
+using testing::window_scene;
 
-constexpr double kSe = 3.0;  // tolerance in standard errors (fixed seeds)
-constexpr double kPi = std::numbers::pi;
 constexpr EventProbabilities kSchemes[] = {EventProbabilities::Max, EventProbabilities::Average,
                                            EventProbabilities::Mixed, EventProbabilities::Implicit};
-
-// Gauss–Legendre nodes and weights on [a, b] (as in test_render_directional.cpp).
-void gauss_legendre(int n, double a, double b, std::vector<double>& x, std::vector<double>& w) {
-  x.assign(n, 0.0);
-  w.assign(n, 0.0);
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 0.0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1.0, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1.0);
-      const double dz = p1 / dp;
-      z -= dz;
-      if (std::abs(dz) < 1e-15) break;
-    }
-    x[i] = 0.5 * (a + b) - 0.5 * (b - a) * z;
-    w[i] = (b - a) / ((1.0 - z * z) * dp * dp);
-  }
-}
-
-double integrate(const std::function<double(double)>& f, double a, double b, int n = 16) {
-  std::vector<double> x, w;
-  gauss_legendre(n, a, b, x, w);
-  double s = 0.0;
-  for (int i = 0; i < n; ++i) s += w[i] * f(x[i]);
-  return s;
-}
-
-// Chandrasekhar's H function of an isotropic scatterer of albedo ω (iteration of the H-equation in
-// its "improved" form on 64 Gauss–Legendre nodes; test_render_directional.cpp checks it).
-double chandrasekhar_h(double albedo, double mu) {
-  std::vector<double> x, q;
-  gauss_legendre(64, 0.0, 1.0, x, q);
-  std::vector<double> h(x.size(), 1.0);
-  auto eval = [&](double m) {
-    double s = 0.0;
-    for (std::size_t j = 0; j < x.size(); ++j) s += q[j] * x[j] * h[j] / (m + x[j]);
-    return 1.0 / (std::sqrt(1.0 - albedo) + 0.5 * albedo * s);
-  };
-  for (int it = 0; it < 500; ++it) {
-    double change = 0.0;
-    std::vector<double> next(x.size());
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      next[i] = eval(x[i]);
-      change = std::max(change, std::abs(next[i] - h[i]));
-    }
-    h = next;
-    if (change < 1e-13) break;
-  }
-  return eval(mu);
-}
-
-double hg(double cos_theta, double g) {
-  return (1.0 - g * g) / (4.0 * kPi * std::pow(1.0 + g * g - 2.0 * g * cos_theta, 1.5));
-}
 
 TEST(EventProbability, NamesRoundTripAndBadNamesAreRefused) {
   for (EventProbabilities e : {EventProbabilities::Auto, EventProbabilities::Max, EventProbabilities::Average,
@@ -218,15 +162,6 @@ TEST(EventProbability, ChromaticFurnaceIsOneForEveryScheme) {
   }
 }
 
-// A 0.1-wide window of the unit box seen straight down, lit by `light` only (as in
-// test_render_directional.cpp).
-Scene window_scene(const Material& m, const Light& light, int pixels, std::int64_t spp) {
-  Scene s = box_scene(m, 4, pixels, spp);
-  s.camera.ortho_height = 0.1;
-  s.lights = {light};
-  return s;
-}
-
 TEST(EventProbability, SingleScatteringWithChromaticAlbedoForEveryScheme) {
   // Single scattering (max_bounces = 1) in a slab of depth 1, σt from 0.5 to 0.05 per unit and the
   // albedo from 0.2 to 0.9 over 400–700 nm, HG g = 0.5, a delta light 20° from the zenith:
@@ -246,7 +181,7 @@ TEST(EventProbability, SingleScatteringWithChromaticAlbedoForEveryScheme) {
                                 const double t = (l - 400.0) / 300.0;
                                 const double w = 0.2 + 0.7 * t, tau = 0.5 - 0.45 * t;
                                 return w * hg(-mu0, g) * (1.0 - std::exp(-tau * k)) / k;
-                              }, lo, hi) / (hi - lo);
+                              }, lo, hi, 16) / (hi - lo);
       EXPECT_NEAR(m.mean[b], expected, kSe * m.se[b]) << event_probabilities_name(e) << " bin " << b;
       EXPECT_LT(m.se[b], 0.03 * expected) << event_probabilities_name(e) << " bin " << b;
     }
@@ -263,7 +198,8 @@ TEST(EventProbability, SaturatedHalfSpaceMatchesChandrasekharForEveryScheme) {
     const double lo = 400.0 + 50.0 * b, hi = lo + 50.0;
     expected[b] = integrate([&](double l) {
                     const double w = 0.3 + 0.65 * (l - 400.0) / 300.0;
-                    return w * mu0 * chandrasekhar_h(w, 1.0) * chandrasekhar_h(w, mu0) / (4.0 * kPi * (1.0 + mu0));
+                    const HFunction h(w);
+                    return w * mu0 * h(1.0) * h(mu0) / (4.0 * kPi * (1.0 + mu0));
                   }, lo, hi, 6) / (hi - lo);
   }
   for (EventProbabilities e : kSchemes) {

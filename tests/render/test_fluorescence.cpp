@@ -7,7 +7,6 @@
 #include <cmath>
 #include <functional>
 #include <nlohmann/json.hpp>
-#include <numbers>
 #include <vector>
 
 #include "prizma/render/fluorescence.h"
@@ -25,9 +24,8 @@ namespace {
 using spectral::Spectrum;
 using testing::box_scene;
 using testing::grey_material;
-
-constexpr double kSe = 3.0;  // tolerance in standard errors (fixed seeds)
-constexpr double kPi = std::numbers::pi;
+using testing::kPi;
+using testing::kSe;
 
 // σf per unit: 2 at 400 nm falling to 0 at 500 nm (zero outside the table).
 Spectrum dye_absorption(double scale) { return Spectrum({400.0, 450.0, 500.0}, {2.0 * scale, 1.0 * scale, 0.0}); }
@@ -159,6 +157,36 @@ TEST(Fluorescence, QuantumYieldZeroIsBeerLambertWithSigmaTPlusSigmaF) {
   EXPECT_LT(e.mean[0], std::exp(-st) - 10.0 * e.se[0]);
 }
 
+// Renders s as it is (bispectral) and with its light spectra folded in (the same random numbers),
+// and checks that relighting the first with those spectra, T·ē + M·ē per light summed over the
+// lights, equals the second bin for bin (up to float rounding). Returns both renders.
+struct BispectralAndFolded {
+  spectral::SpectralImage bispectral, folded;
+};
+BispectralAndFolded expect_relit_equals_folded(Scene s) {
+  BispectralAndFolded r;
+  r.bispectral = render(s);
+  s.settings.fold_light_spectra = true;
+  r.folded = render(s);
+  const spectral::SpectralImage& bi = r.bispectral;
+  EXPECT_FALSE(bi.reradiation.empty());
+  EXPECT_TRUE(r.folded.reradiation.empty());
+  const int nb = bi.bins.size();
+  std::vector<double> relit(bi.pixel_count() * nb, 0.0), want(bi.pixel_count() * nb, 0.0);
+  for (std::size_t l = 0; l < s.lights.size(); ++l) {
+    spectral::SpecContext ctx;
+    const std::vector<double> e = spectral::parse_spectrum(s.lights[l].spectrum_spec, ctx).bin_averages(bi.bins);
+    for (std::size_t k = 0; k < relit.size(); ++k) {
+      relit[k] += bi.lights[l].data[k] * e[k % nb];
+      want[k] += r.folded.lights[l].data[k];
+    }
+    spectral::add_reradiated(bi, static_cast<int>(l), e, relit);
+  }
+  for (std::size_t k = 0; k < relit.size(); ++k)
+    EXPECT_NEAR(relit[k], want[k], 2e-4 * (1.0 + std::abs(want[k]))) << "pixel " << k / nb << " bin " << k % nb;
+  return r;
+}
+
 // Relighting the bispectral file under E (diagonal T·ē plus Σ_in M[out][in]·ē_in) equals rendering
 // with E folded into the paths. Both lights are constant inside every bin (box spectra on the bin
 // edges), where relighting is exact; the two renders share their random numbers.
@@ -169,26 +197,10 @@ TEST(Fluorescence, RelightingTheBispectralImageEqualsFoldingTheLightIn) {
   s.lights[0].spectrum_spec = "box:450:650";                        // environment
   s.lights.push_back(testing::directional_light("uv", {0.3, 0.2, 1}));
   s.lights[1].spectrum_spec = "box:400:500*2";
-  const spectral::SpectralImage bi = render(s);
-  ASSERT_FALSE(bi.reradiation.empty());
-  s.settings.fold_light_spectra = true;
-  const spectral::SpectralImage folded = render(s);
-  EXPECT_TRUE(folded.reradiation.empty());
+  const BispectralAndFolded r = expect_relit_equals_folded(s);
+  const spectral::SpectralImage& bi = r.bispectral;
+  const spectral::SpectralImage& folded = r.folded;
   const int nb = bi.bins.size();
-  std::vector<double> relit(bi.pixel_count() * nb, 0.0);
-  for (int l = 0; l < 2; ++l) {
-    spectral::SpecContext ctx;
-    const std::vector<double> e = spectral::parse_spectrum(s.lights[l].spectrum_spec, ctx).bin_averages(bi.bins);
-    for (std::size_t px = 0; px < bi.pixel_count(); ++px)
-      for (int i = 0; i < nb; ++i) relit[px * nb + i] += bi.lights[l].data[px * nb + i] * e[i];
-    spectral::add_reradiated(bi, l, e, relit);
-  }
-  for (std::size_t px = 0; px < bi.pixel_count(); ++px)
-    for (int i = 0; i < nb; ++i) {
-      double want = 0.0;
-      for (int l = 0; l < 2; ++l) want += folded.lights[l].data[px * nb + i];
-      EXPECT_NEAR(relit[px * nb + i], want, 2e-4 * (1.0 + std::abs(want))) << "pixel " << px << " bin " << i;
-    }
   double reradiated = 0.0;
   for (float v : bi.lights[1].reradiation) reradiated += v;
   EXPECT_GT(reradiated, 0.0);
@@ -258,23 +270,7 @@ TEST(Fluorescence, SingleWavelengthSamplingRelitEqualsSpectralTracking) {
   // Folded (the same random numbers): T·ē + M·ē of the single render equals its folded render.
   s.lights[0].spectrum_spec = "box:450:650";
   s.lights[1].spectrum_spec = "box:400:500*2";
-  const spectral::SpectralImage bi = render(s);
-  s.settings.fold_light_spectra = true;
-  const spectral::SpectralImage folded = render(s);
-  const int nb = bi.bins.size();
-  std::vector<double> relit(bi.pixel_count() * nb, 0.0);
-  for (int l = 0; l < 2; ++l) {
-    spectral::SpecContext ctx;
-    const std::vector<double> e = spectral::parse_spectrum(s.lights[l].spectrum_spec, ctx).bin_averages(bi.bins);
-    for (std::size_t px = 0; px < bi.pixel_count(); ++px)
-      for (int i = 0; i < nb; ++i) relit[px * nb + i] += bi.lights[l].data[px * nb + i] * e[i];
-    spectral::add_reradiated(bi, l, e, relit);
-  }
-  for (std::size_t px = 0; px < bi.pixel_count(); ++px)
-    for (int i = 0; i < nb; ++i) {
-      const double want = folded.lights[0].data[px * nb + i] + folded.lights[1].data[px * nb + i];
-      EXPECT_NEAR(relit[px * nb + i], want, 2e-4 * (1.0 + std::abs(want))) << "pixel " << px << " bin " << i;
-    }
+  expect_relit_equals_folded(s);
 }
 
 // The scene field: the happy path and one-line errors naming the field.

@@ -118,13 +118,17 @@ void write_spectral_exr(const std::filesystem::path& path, const SpectralImage& 
 //
 // prizma:checksum is verified unless opts.verify_checksum is false: a mismatch is InputError "pixel
 // data do not match prizma:checksum", saying when the header shows that another tool re-encoded the
-// file (half, PXR24, B44: the values changed, the attribute was copied).
+// file (half, PXR24, B44: the values changed, the attribute was copied), and naming
+// opts.unverified_read, the caller's way to read the file anyway.
 //
 // Spectral-basis coefficients (docs/spectral-exr.md): read into TransportLayer::coefficients only
 // with read_coefficients (else their channels are read only to verify the checksum). A compact
 // file (coefficients, no bins) is refused with an InputError that says so unless allow_compact.
 struct ExrReadOptions {
   bool verify_checksum = true;
+  // How the user of the calling tool turns the check off, for the mismatch message ("--no-verify"
+  // in every executable that reads spectral EXR files; "verify=False" in Python).
+  std::string unverified_read = "--no-verify";
   bool read_coefficients = false;
   bool allow_compact = false;
 };

@@ -6,22 +6,11 @@
 
 namespace prizma::relight::detail {
 
-// One light layer: its 3×n weights row-major (X row, Y row, Z row) and its transport
-// (width·height·n floats, pixel-major, bins contiguous).
-struct SimdLayer {
-  const float* weights;
-  const float* transport;
-};
-
-// out[3x + c] = Σ_l Σ_i weights_l[c·n + i] · transport_l[(first_pixel + x)·n + i], x in [0, width).
-void relight_row_simd(const SimdLayer* layers, int layer_count, int n, std::size_t first_pixel, int width,
-                      float* out);
-
-// The folded relight of a fluorescent (bispectral) image: terms with their own value counts, summed in
-// one pass per pixel. out[3x + c] = Σ_t Σ_j weights_t[c·n_t + j] · values_t[(first_pixel + x)·n_t + j].
-// A light's transport layer is a term (n_t = bins); a bispectral light's re-radiation weights K
-// (3·|in bins| values per pixel, relight_image.h) are another, with weights output[c][c']·ē[in]
-// (relight_image.cpp), so the K·ē product shares the diagonal's row pass and dispatch.
+// One row of the relight XYZ = Σ_t W_t·V_t: terms with their own value counts, summed in one pass per
+// pixel. out[3x + c] = Σ_t Σ_j weights_t[c·n_t + j] · values_t[(first_pixel + x)·n_t + j], x in [0, width).
+// A light's transport layer is a term (n_t = bins, weights its 3×n relight matrix); a bispectral
+// light's re-radiation weights K (3·|in bins| values per pixel, relight_image.h) are another, with
+// weights output[c][c']·ē[in] (relight_image.cpp), so the K·ē product shares the diagonal's row pass.
 struct SimdTerm {
   const float* weights;  // 3·n floats, row-major
   const float* values;   // n floats per pixel, pixel-major
@@ -31,7 +20,7 @@ void relight_row_terms_simd(const SimdTerm* terms, int term_count, std::size_t f
 
 // The targets compiled in that this CPU runs, best first (e.g. "AVX3", "AVX2", "SSE4", …, "EMU128").
 std::vector<std::string> relight_simd_targets();
-// The one relight_row_simd uses now.
+// The one relight_row_terms_simd uses now.
 std::string relight_simd_target();
 // Tests: use only the named target from now on ("" = back to the best). Not thread-safe.
 void relight_simd_force_target(const std::string& name);
