@@ -44,6 +44,44 @@ ConstLanes<kLanes> lanes_of(const std::vector<float>& v, int n, std::size_t row 
   return ConstLanes<kLanes>(v.data() + row * static_cast<std::size_t>(n), n);
 }
 
+// Calls put(i, s.eval(λ_i)) for each lane's wavelength λ_i (float, as the cache holds them), with
+// the values Spectrum::eval returns (the same table interval, the same interpolation expression),
+// without a binary search per lane: the interval is guessed as if the table were evenly spaced
+// (CSV tables usually are: 1 nm) and corrected by steps until it is std::upper_bound's, which it
+// then is for any increasing table. The binary searches were a fifth of a path's time on
+// data/scenes/bench_peer.json.
+template <class Put>
+void eval_lanes(const spectral::Spectrum& s, const float* lambda_nm, int n, Put&& put) {
+  if (s.is_constant()) {
+    const double c = s.eval(0.0);
+    for (int i = 0; i < n; ++i) put(i, c);
+    return;
+  }
+  const std::vector<double>& x = s.wavelengths_nm();
+  const std::vector<double>& y = s.values();
+  const std::size_t m = x.size();
+  const double per_nm = m >= 2 ? static_cast<double>(m - 1) / (x.back() - x.front()) : 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double l = lambda_nm[i];
+    if (m < 2 || !(l >= x.front() && l <= x.back())) {
+      put(i, 0.0);
+      continue;
+    }
+    // j: the first entry > l (x[j − 1] ≤ l < x[j]; j = m when l is the last entry).
+    auto j = static_cast<std::size_t>((l - x.front()) * per_nm) + 1;
+    j = std::min(j, m);
+    while (j < m && !(l < x[j])) ++j;
+    while (j > 1 && l < x[j - 1]) --j;
+    if (j >= m) {
+      put(i, y.back());
+      continue;
+    }
+    const std::size_t k = j - 1;
+    const double t = (l - x[k]) / (x[k + 1] - x[k]);
+    put(i, y[k] + t * (y[k + 1] - y[k]));
+  }
+}
+
 }  // namespace
 
 double spectrum_max_over(const spectral::Spectrum& s, double lo_nm, double hi_nm) {
@@ -168,13 +206,13 @@ void PathTracer::evaluate_material(int m, PathScratch& s) const {
   float* al = s.cache.albedo.data() + static_cast<std::size_t>(m) * n;
   float* g = s.cache.g.data() + static_cast<std::size_t>(m) * n;
   float* le = s.cache.emission_le.data() + static_cast<std::size_t>(m) * n;
-  for (int i = 0; i < n; ++i) {
-    const double l = s.cache.lambda_nm[i];
-    st[i] = static_cast<float>(std::max(0.0, mat.sigma_t_per_unit.eval(l)));
-    al[i] = static_cast<float>(std::clamp(mat.albedo.eval(l), 0.0, 1.0));
-    g[i] = static_cast<float>(std::clamp(mat.anisotropy.eval(l), -0.9999, 0.9999));
-    if (m_emits[m]) le[i] = static_cast<float>(std::max(0.0, mat.emission.eval(l)));
-  }
+  const float* lambda = s.cache.lambda_nm.data();
+  eval_lanes(mat.sigma_t_per_unit, lambda, n, [st](int i, double v) { st[i] = static_cast<float>(std::max(0.0, v)); });
+  eval_lanes(mat.albedo, lambda, n, [al](int i, double v) { al[i] = static_cast<float>(std::clamp(v, 0.0, 1.0)); });
+  eval_lanes(mat.anisotropy, lambda, n,
+             [g](int i, double v) { g[i] = static_cast<float>(std::clamp(v, -0.9999, 0.9999)); });
+  if (m_emits[m])
+    eval_lanes(mat.emission, lambda, n, [le](int i, double v) { le[i] = static_cast<float>(std::max(0.0, v)); });
   if (mat.fluorescent) evaluate_fluorescence(m, s);
   s.cache.stamp[m] = s.cache.path_id;
 }
