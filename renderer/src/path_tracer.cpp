@@ -469,9 +469,9 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
     const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
     const ConstLanes<kLanes> albedo = lanes_of<kLanes>(std::as_const(s.cache.albedo), n, m);
     const float mu = tc.mu;
-    // The three coefficients and, for the default max scheme, their maxima in one pass over the
-    // lanes (the hot loop of a render: one pass, not four; the same float operations as the Lanes
-    // expressions ss = d·σt·α, sa = d·σt − ss, sn = max(0, μ̄ − d·σt)).
+    // The three coefficients in one pass over the lanes (the hot loop of a render; the same float
+    // operations as the Lanes expressions ss = d·σt·α, sa = d·σt − ss, sn = max(0, μ̄ − d·σt)),
+    // then, for the default max scheme, their maxima.
     EventCoefficients ev;
     {
       const float* __restrict st = sigma_t.data();
@@ -486,13 +486,13 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
         ps[i] = sig_t * al[i];
         pa[i] = sig_t - ps[i];
         pn[i] = std::max(0.0f, mu - sig_t);
-        if (max_scheme) {
-          ev.absorb = std::max(ev.absorb, wi[i] * pa[i]);
-          ev.scatter = std::max(ev.scatter, wi[i] * ps[i]);
-          ev.null = std::max(ev.null, wi[i] * pn[i]);
-        }
       }
-      if (!max_scheme) ev = event_coefficients(m_events[m], n, wi, pa, ps, pn);
+      // After the loop, not in it: max_over's partial maxima vectorise, and so does the loop
+      // without them (a running max kept both scalar); the same bits (lanes.h, max_from_zero).
+      if (max_scheme)
+        ev = EventCoefficients{.absorb = max_over(w * sa, n), .scatter = max_over(w * ss, n), .null = max_over(w * sn, n)};
+      else
+        ev = event_coefficients(m_events[m], n, wi, pa, ps, pn);
     }
     const float ma = ev.absorb, ms = ev.scatter, mn = ev.null;
     float mf = 0.0f;
