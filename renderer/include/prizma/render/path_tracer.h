@@ -16,6 +16,7 @@
 #include "prizma/render/majorant_grid.h"
 #include "prizma/render/rng.h"
 #include "prizma/render/scene.h"
+#include "prizma/render/simd_level.h"
 
 namespace prizma::render {
 
@@ -102,8 +103,12 @@ class PathTracer {
   // Sizes scratch for `lanes` lanes.
   void prepare(PathScratch& scratch, int lanes) const;
   // Traces the path of a camera ray at the wavelengths in scratch.in.lambda_nm (set by the caller).
-  // Results in scratch.out (overwritten).
+  // Results in scratch.out (overwritten), the same bits at every SIMD level.
   void trace(const Ray& ray, Rng& rng, PathScratch& scratch) const;
+  // The instruction set trace() runs on: default_simd_level() when built. set_simd_level throws
+  // InputError("simd", …) for a level this CPU does not support (supported_simd_levels()).
+  SimdLevel simd_level() const { return m_simd; }
+  void set_simd_level(SimdLevel level);
 
   // Lights with their own result in scratch.directional (directional, point, sphere, spot and
   // environment-map lights; not the uniform environment nor emission), in scene order: their
@@ -131,6 +136,10 @@ class PathTracer {
   template <int kLanes>
   struct PathState;
 
+  // trace() compiled for each SimdLevel: the whole path (everything it inlines) at that level.
+  void trace_baseline(const Ray& ray, Rng& rng, PathScratch& s) const;
+  void trace_avx2(const Ray& ray, Rng& rng, PathScratch& s) const;
+  void trace_avx512(const Ray& ray, Rng& rng, PathScratch& s) const;
   // One path, the way pbrt-v4's volpath reads: free flight (→ absorbed / scattered / escaped),
   // light estimates, phase sampling, roulette.
   template <int kLanes>
@@ -161,6 +170,7 @@ class PathTracer {
   void classify(float value, std::uint16_t& material, float& density) const;
 
   const Medium* m_medium;
+  SimdLevel m_simd = SimdLevel::Baseline;
   MajorantGrid m_grid;
   Eigen::Vector3d m_inv_voxel;
   std::vector<LightSampler> m_lights;
