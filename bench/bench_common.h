@@ -150,6 +150,7 @@ inline spectral::SpectralImage cached_render(const render::Scene& scene, const f
       << st.sample_begin << ':' << st.sample_end << '|' << st.seed << '|'
       << render::wavelength_sampling_name(st.wavelength_sampling) << '|' << st.fold_light_spectra << '|'
       << st.write_variance << '|' << st.max_bounces << '|' << render::event_probabilities_name(st.event_probabilities);
+  if (st.sampler != render::Sampler::Independent) key << '|' << render::sampler_name(st.sampler);  // older keys unchanged
   for (const auto& l : scene.lights) key << '|' << l.name << ':' << l.spectrum_spec;
   const fs::path file = cache_dir / (tag + "-" + hash_hex(key.str()) + ".exr");
   if (fs::exists(file)) {

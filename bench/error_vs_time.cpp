@@ -24,6 +24,7 @@ struct Method {
   pr::WavelengthSampling sampling;
   bool grid;
   pr::EventProbabilities events = pr::EventProbabilities::Auto;
+  pr::Sampler sampler = pr::Sampler::Independent;
 };
 
 struct Options {
@@ -47,7 +48,7 @@ int main(int argc, char** argv) {
   app.add_option("--scenes", o.scenes, "grey, cube, metamers, mri");
   app.add_option("--methods", o.methods,
                  "single, single-nogrid, spectral (auto event probabilities), spectral-nogrid, spectral-max, "
-                 "spectral-average, spectral-mixed, spectral-implicit");
+                 "spectral-average, spectral-mixed, spectral-implicit, spectral-sobol, single-sobol (the Sobol' sampler)");
   app.add_option("--size", o.size, "image width and height in pixels");
   app.add_option("--ref-spp", o.ref_spp, "reference samples per pixel (spectral tracking, grid)");
   app.add_option("--max-spp", o.max_spp, "largest sample count of the measured renders (powers of 2 up to it)");
@@ -67,6 +68,8 @@ int main(int argc, char** argv) {
       {"spectral-average", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Average},
       {"spectral-mixed", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Mixed},
       {"spectral-implicit", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Implicit},
+      {"spectral-sobol", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Auto, pr::Sampler::Sobol},
+      {"single-sobol", pr::WavelengthSampling::Single, true, pr::EventProbabilities::Auto, pr::Sampler::Sobol},
   };
   std::vector<Method> methods;
   for (const std::string& name : o.methods) {
@@ -130,6 +133,7 @@ int main(int argc, char** argv) {
           s.settings.wavelength_sampling = m.sampling;
           s.settings.use_majorant_grid = m.grid;
           s.settings.event_probabilities = m.events;
+          s.settings.sampler = m.sampler;
           s.settings.seed = o.seed;
           s.settings.write_variance = false;
           // Each sample count is a fresh render of samples [0, n): its wall time includes the set-up

@@ -6,7 +6,8 @@
 // 1-spp render, wall time and peak resident memory of the process.
 //
 //   bench_peer --render build-bench/renderer/prizma-render [--repeats 5] [--threads 2]
-//              [--reference-spp 16384] [--cache build-bench/cache] [--csv FILE]
+//              [--reference-spp 16384] [--cache build-bench/cache] [--csv FILE] [--sampler NAME]
+// --sampler passes --sampler NAME to the timed renders (the reference is the scene's own).
 // Driven by bench/peer (writes docs/results/peer.{csv,txt}).
 #include <fcntl.h>
 #include <spawn.h>
@@ -104,7 +105,7 @@ std::string fmt(double v, int prec) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string render_exe, csv_path;
+  std::string render_exe, csv_path, sampler;
   fs::path scene_path = bench::source_data_dir() / "scenes" / "bench_peer.json";
   fs::path cache = "build-bench/cache";
   int repeats = 5, threads = 2;
@@ -124,6 +125,7 @@ int main(int argc, char** argv) {
     else if (a == "--cache") cache = next();
     else if (a == "--csv") csv_path = next();
     else if (a == "--repeats") repeats = std::stoi(next());
+    else if (a == "--sampler") sampler = next();
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--reference-spp") reference_spp = std::stoll(next());
     else if (a == "--quick") {
@@ -132,7 +134,7 @@ int main(int argc, char** argv) {
       reference_spp = 4096;
     } else {
       std::cerr << "usage: bench_peer --render PRIZMA_RENDER [--scene S] [--repeats N] [--threads T] "
-                   "[--reference-spp N] [--cache DIR] [--csv FILE] [--quick]\n";
+                   "[--reference-spp N] [--cache DIR] [--csv FILE] [--sampler NAME] [--quick]\n";
       return a == "--help" ? 0 : 2;
     }
   }
@@ -185,6 +187,7 @@ int main(int argc, char** argv) {
     // what the wall would be with the threads' cores to themselves (a lower bound: no serial part).
     csv << "spp,seconds,cpu_seconds,rel_rmse,efficiency,efficiency_cpu,pbrt_efficiency,ratio_to_pbrt,ratio_to_pbrt_cpu,"
            "issue_prizma_ratio\n";
+    if (!sampler.empty()) text << "sampler: " << sampler << "\n\n";
     text << "| spp | Prizma wall s (median of " << repeats << ") | CPU s / " << threads
          << " | relRMSE | efficiency (wall) | pbrt-v4 efficiency (issue 14) | Prizma ÷ pbrt (wall) | "
             "Prizma ÷ pbrt (CPU / threads) | in issue 14 |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
@@ -192,8 +195,10 @@ int main(int argc, char** argv) {
       std::vector<double> secs, cpus;
       double mse = 0.0;
       for (int r = 0; r < repeats; ++r) {
-        const RunResult res = run({render_exe, scene_path.string(), "--spp", std::to_string(spp), "--seed",
-                                   std::to_string(1 + r), "--threads", th, "-q", "-o", out});
+        std::vector<std::string> cmd = {render_exe, scene_path.string(), "--spp", std::to_string(spp), "--seed",
+                                        std::to_string(1 + r), "--threads", th, "-q", "-o", out};
+        if (!sampler.empty()) cmd.insert(cmd.end(), {"--sampler", sampler});
+        const RunResult res = run(cmd);
         secs.push_back(res.seconds);
         cpus.push_back(res.cpu_seconds / threads);
         const spectral::SpectralImage img = spectral::read_spectral_exr(out);

@@ -70,6 +70,7 @@ struct Options {
   std::string samples;
   int threads = 0;
   std::string wavelength_sampling;
+  std::string sampler;
   std::optional<double> target_error;
   bool no_majorant_grid = false;
   bool variance = false;
@@ -219,6 +220,9 @@ int main(int argc, char** argv) {
   app.add_option("--wavelength-sampling", o.wavelength_sampling,
                  "spectral-tracking (all bins per path) or single (VPT: one wavelength per path)")
       ->check(CLI::IsMember({"spectral-tracking", "single"}));
+  app.add_option("--sampler", o.sampler,
+                 "independent (PCG per sample) or sobol (the first draws of each path from a scrambled Sobol' point)")
+      ->check(CLI::IsMember({"independent", "sobol"}));
   app.add_option("--target-error", o.target_error,
                  "stop a pixel once its relative standard error is at most this (after 16 samples)")
       ->check(CLI::NonNegativeNumber);
@@ -258,6 +262,7 @@ int main(int argc, char** argv) {
     if (!o.bins.empty()) given.bins = o.bins;
     given.seed = o.seed;
     if (!o.wavelength_sampling.empty()) given.wavelength_sampling = o.wavelength_sampling;
+    if (!o.sampler.empty()) given.sampler = o.sampler;
     given.target_error = o.target_error;
     given.no_majorant_grid = o.no_majorant_grid;
     given.variance = o.variance;
@@ -321,7 +326,8 @@ int main(int argc, char** argv) {
       std::cerr << kProgram << ": scene " << scene.source.string() << " (hash " << scene.hash << "), "
                 << scene.camera.width << "×" << scene.camera.height << ", " << st.bins.size() << " bins "
                 << st.bins.to_string() << ", samples " << st.sample_begin << ":" << st.sample_end << ", seed "
-                << st.seed << ", " << render::wavelength_sampling_name(st.wavelength_sampling)
+                << st.seed << ", " << render::wavelength_sampling_name(st.wavelength_sampling) << ", "
+                << render::sampler_name(st.sampler) << " sampler"
                 << (st.use_majorant_grid ? ", majorant grid" : ", global majorant") << "\n";
       std::cerr << kProgram << ": event probabilities ("
                 << render::event_probabilities_name(st.event_probabilities) << "): "

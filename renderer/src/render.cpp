@@ -91,7 +91,7 @@ class PixelRenderer {
     const std::size_t per_pixel = ts.value.size();
     for (std::int64_t s = s0; s < s1; ++s) {
       if (cancelled()) return;
-      Rng rng(st.seed, pix, static_cast<std::uint64_t>(s));
+      Rng rng(st.seed, pix, static_cast<std::uint64_t>(s), st.sampler);
       const double px = x + rng.uniform_double();
       const double py = y + rng.uniform_double();
       const Ray ray = m_c.camera.generate(px, py);
@@ -274,6 +274,14 @@ WavelengthSampling parse_wavelength_sampling(std::string_view name, std::string_
   if (name == "single") return WavelengthSampling::Single;
   throw InputError(std::string(input),
                    "unknown wavelength sampling \"" + std::string(name) + "\" (known: spectral-tracking, single)");
+}
+
+std::string sampler_name(Sampler s) { return s == Sampler::Sobol ? "sobol" : "independent"; }
+
+Sampler parse_sampler(std::string_view name, std::string_view input) {
+  if (name == "independent") return Sampler::Independent;
+  if (name == "sobol") return Sampler::Sobol;
+  throw InputError(std::string(input), "unknown sampler \"" + std::string(name) + "\" (known: independent, sobol)");
 }
 
 spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callbacks, RenderStats* stats_out) {

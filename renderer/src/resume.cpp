@@ -29,6 +29,7 @@ void apply_overrides(Scene& scene, const RenderOverrides& o, const std::string& 
   if (o.seed) st.seed = *o.seed;
   if (o.wavelength_sampling)
     st.wavelength_sampling = parse_wavelength_sampling(*o.wavelength_sampling, input_prefix + "wavelength-sampling");
+  if (o.sampler) st.sampler = parse_sampler(*o.sampler, input_prefix + "sampler");
   if (o.target_error) st.target_error = *o.target_error;
   if (o.no_majorant_grid) st.use_majorant_grid = false;
   if (o.variance) st.write_variance = true;
@@ -41,6 +42,7 @@ std::string overrides_to_json(const RenderOverrides& o) {
   if (o.bins) j["bins"] = *o.bins;
   if (o.seed) j["seed"] = std::to_string(*o.seed);  // a string: JSON readers lose integers above 2^53
   if (o.wavelength_sampling) j["wavelength-sampling"] = *o.wavelength_sampling;
+  if (o.sampler) j["sampler"] = *o.sampler;
   if (o.target_error) j["target-error"] = *o.target_error;
   if (o.no_majorant_grid) j["no-majorant-grid"] = true;
   if (o.variance) j["variance"] = true;
@@ -60,9 +62,9 @@ RenderOverrides overrides_from_json(const std::string& text, const std::string& 
     if (key == "width" || key == "height") {
       if (!v.is_number_integer() || v.get<std::int64_t>() < 1 || v.get<std::int64_t>() > (1 << 30)) throw bad(key);
       (key == "width" ? o.width : o.height) = v.get<int>();
-    } else if (key == "bins" || key == "wavelength-sampling") {
+    } else if (key == "bins" || key == "wavelength-sampling" || key == "sampler") {
       if (!v.is_string()) throw bad(key);
-      (key == "bins" ? o.bins : o.wavelength_sampling) = v.get<std::string>();
+      (key == "bins" ? o.bins : key == "sampler" ? o.sampler : o.wavelength_sampling) = v.get<std::string>();
     } else if (key == "seed") {
       if (!v.is_string()) throw bad(key);
       try {
@@ -141,6 +143,7 @@ ResumePlan plan_resume(const ResumeRequest& req) {
     check("seed", given.seed.has_value(), given.seed == o.seed, "seed " + opt(o.seed));
     check("wavelength-sampling", given.wavelength_sampling.has_value(),
           given.wavelength_sampling == o.wavelength_sampling, "wavelength sampling " + opt(o.wavelength_sampling));
+    check("sampler", given.sampler.has_value(), given.sampler == o.sampler, "sampler " + opt(o.sampler));
     check("target-error", given.target_error.has_value(), given.target_error == o.target_error,
           "target error " + opt(o.target_error));
     check("no-majorant-grid", given.no_majorant_grid, o.no_majorant_grid, "the majorant grid");

@@ -695,6 +695,8 @@ void read_settings(const Reader& rd, const json& root, RenderSettings& s) {
     else if (w == "single") s.wavelength_sampling = WavelengthSampling::Single;
     else rd.fail("wavelength_sampling", "must be \"spectral-tracking\" or \"single\" (got \"" + w + "\")");
   }
+  if (root.contains("sampler"))
+    s.sampler = parse_sampler(rd.string(root.at("sampler"), "sampler"), rd.input("sampler"));
   if (root.contains("event_probabilities"))
     s.event_probabilities = parse_event_probabilities(rd.string(root.at("event_probabilities"), "event_probabilities"),
                                                       rd.input("event_probabilities"));
@@ -957,7 +959,7 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverr
     rd.fail("normalization", "give normalisation or normalization (the same field), not both");
   rd.expect_object(root, "",
                    {"description", "volume", "normalisation", "normalization", "materials", "transfer_function", "camera", "lights",
-                    "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "event_probabilities", "target_error", "output",
+                    "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "sampler", "event_probabilities", "target_error", "output",
                     "emission_light"});
   if (root.contains("description")) rd.string(root.at("description"), "description");
   if (!root.contains("volume")) rd.fail("volume", "is required");

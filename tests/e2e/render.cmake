@@ -40,3 +40,13 @@ prizma_render_e2e(bad_bins "${_tiny}|--bins|linear:700:400:3|-o|bad.exr" EXPECT_
   ERR_REGEX "--bins" ERR_LINES 1)
 prizma_render_e2e(bad_sampling "${_tiny}|--wavelength-sampling|hero|-o|bad.exr" EXPECT_RC 2
   MUST_NOT_EXIST bad.exr)
+prizma_render_e2e(bad_sampler "${_tiny}|--sampler|halton|-o|bad.exr" EXPECT_RC 2
+  MUST_NOT_EXIST bad.exr ERR_REGEX "--sampler")
+# The Sobol' sampler: a shard resumes with it (recorded in prizma:renderOptions), and a resume that
+# changes the sampler is refused.
+prizma_render_e2e(sobol_shard "${_tiny}|--sampler|sobol|--samples|0:2|-o|sobol0.exr|-q" MUST_EXIST sobol0.exr
+  FIXTURES_SETUP render_sobol)
+prizma_render_e2e(sobol_resume "${_tiny}|--resume|sobol0.exr|--spp|4|-o|sobol_resumed.exr|-q"
+  MUST_EXIST sobol_resumed.exr FIXTURES_REQUIRED render_sobol)
+prizma_render_e2e(sobol_resume_other_sampler "${_tiny}|--resume|sobol0.exr|--sampler|independent|--spp|4|-o|bad.exr"
+  EXPECT_RC 2 MUST_NOT_EXIST bad.exr ERR_REGEX "--sampler.*sampler sobol" ERR_LINES 1 FIXTURES_REQUIRED render_sobol)

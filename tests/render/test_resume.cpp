@@ -69,6 +69,7 @@ TEST(RenderOverrides, JsonRoundTrip) {
   o.bins = "linear:400:700:4";
   o.seed = std::numeric_limits<std::uint64_t>::max();  // beyond double: stored as a string
   o.wavelength_sampling = "single";
+  o.sampler = "sobol";
   o.target_error = 0.01;
   o.no_majorant_grid = true;
   o.variance = true;

@@ -39,6 +39,7 @@ json base_scene() {
     "seed": 7,
     "max_bounces": 5,
     "wavelength_sampling": "single",
+    "sampler": "sobol",
     "output": "out/x.exr"
   })");
 }
@@ -111,12 +112,13 @@ TEST(SceneLoader, HappyPathFillsEveryField) {
   EXPECT_EQ(s.settings.seed, 7u);
   EXPECT_EQ(s.settings.max_bounces, 5);
   EXPECT_EQ(s.settings.wavelength_sampling, WavelengthSampling::Single);
+  EXPECT_EQ(s.settings.sampler, Sampler::Sobol);
 }
 
 TEST(SceneLoader, DefaultsWhenOptionalFieldsAreMissing) {
   ScratchDir dir;
   json j = base_scene();
-  for (const char* k : {"camera", "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "output", "description"}) {
+  for (const char* k : {"camera", "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "sampler", "output", "description"}) {
     j.erase(k);
   }
   const Scene s = load_scene(write_scene(dir, j, "minimal.json"));
@@ -126,6 +128,7 @@ TEST(SceneLoader, DefaultsWhenOptionalFieldsAreMissing) {
   EXPECT_EQ(s.settings.seed, 1u);
   EXPECT_EQ(s.settings.max_bounces, -1);
   EXPECT_EQ(s.settings.wavelength_sampling, WavelengthSampling::SpectralTracking);
+  EXPECT_EQ(s.settings.sampler, Sampler::Independent);
   EXPECT_EQ(s.settings.event_probabilities, EventProbabilities::Auto);
   EXPECT_EQ(s.settings.bins, spectral::BinLayout());
   // The scheme is a scene field, so -D sets it too.
@@ -388,6 +391,9 @@ TEST(SceneLoaderErrors, CameraAndSettings) {
   j = base_scene();
   j["wavelength_sampling"] = "hero";
   expect_error(dir, j, "wavelength_sampling", "spectral-tracking");
+  j = base_scene();
+  j["sampler"] = "halton";
+  expect_error(dir, j, "sampler", "known: independent, sobol");
   j = base_scene();
   j["event_probabilities"] = "maximum";
   expect_error(dir, j, "event_probabilities", "\"max\", \"average\"");

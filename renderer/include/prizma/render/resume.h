@@ -20,6 +20,7 @@ struct RenderOverrides {
   std::optional<std::string> bins;                 // as given: "linear:400:700:12"
   std::optional<std::uint64_t> seed;
   std::optional<std::string> wavelength_sampling;  // "spectral-tracking" / "single"
+  std::optional<std::string> sampler;              // "independent" / "sobol"
   std::optional<double> target_error;
   bool no_majorant_grid = false;
   bool variance = false;

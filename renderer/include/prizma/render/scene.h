@@ -13,6 +13,7 @@
 #include "prizma/render/environment_map.h"
 #include "prizma/render/event_probability.h"
 #include "prizma/render/material_rule.h"
+#include "prizma/render/rng.h"
 #include "prizma/spectral/bin_layout.h"
 #include "prizma/spectral/spectrum.h"
 
@@ -133,6 +134,7 @@ struct RenderSettings {
   std::uint64_t seed = 1;
   int max_bounces = -1;               // −1 = unlimited (Russian roulette); ≥ 0 = cap
   WavelengthSampling wavelength_sampling = WavelengthSampling::SpectralTracking;
+  Sampler sampler = Sampler::Independent;  // where a path's first random numbers come from (rng.h)
   // Spectral tracking's collision event probabilities (event_probability.h); Auto: chosen from the
   // materials' spectra when the tracer is built.
   EventProbabilities event_probabilities = EventProbabilities::Auto;
