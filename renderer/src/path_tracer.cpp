@@ -388,31 +388,9 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
     const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
     const ConstLanes<kLanes> albedo = lanes_of<kLanes>(std::as_const(s.cache.albedo), n, m);
     const float mu = tc.mu;
-    // The three coefficients and, for the default max scheme, their maxima in one pass over the
-    // lanes (the hot loop of a render: one pass, not four; the same float operations as the Lanes
-    // expressions ss = d·σt·α, sa = d·σt − ss, sn = max(0, μ̄ − d·σt)).
-    EventCoefficients ev;
-    {
-      const float* __restrict st = sigma_t.data();
-      const float* __restrict al = albedo.data();
-      const float* __restrict wi = w.data();
-      float* __restrict pa = sa.data();
-      float* __restrict ps = ss.data();
-      float* __restrict pn = sn.data();
-      const bool max_scheme = m_events[m] == EventProbabilities::Max;
-      for (int i = 0; i < n; ++i) {
-        const float sig_t = d * st[i];
-        ps[i] = sig_t * al[i];
-        pa[i] = sig_t - ps[i];
-        pn[i] = std::max(0.0f, mu - sig_t);
-        if (max_scheme) {
-          ev.absorb = std::max(ev.absorb, wi[i] * pa[i]);
-          ev.scatter = std::max(ev.scatter, wi[i] * ps[i]);
-          ev.null = std::max(ev.null, wi[i] * pn[i]);
-        }
-      }
-      if (!max_scheme) ev = event_coefficients(m_events[m], n, wi, pa, ps, pn);
-    }
+    // The three coefficients and the scheme's m_e in one pass over the lanes (event_probability.h).
+    const EventCoefficients ev = collision_coefficients(m_events[m], n, d, mu, sigma_t.data(), albedo.data(),
+                                                        w.data(), sa.data(), ss.data(), sn.data());
     const float ma = ev.absorb, ms = ev.scatter, mn = ev.null;
     float mf = 0.0f;
     if (m_fluorescent[m]) {
