@@ -43,7 +43,8 @@ struct MaterialEvents {
 // The auto rule (docs/renderer.md, "Event probabilities"), per material, since the scheme may change
 // from one collision to the next without bias: "implicit", except in a material that absorbs more
 // than it scatters in every bin (max_i α_i < kAbsorbingAlbedo), where implicit capture would walk
-// the path through the whole absorber: "average" there. Deterministic: a function of the material's
+// the path through the whole absorber: "max" there (average had 0.86× max's variance on the
+// metamer pair, docs/results.md). Deterministic: a function of the material's
 // spectra and the bins only. `requested` other than Auto is given to every material as it is (the
 // measurements still made).
 inline constexpr double kAbsorbingAlbedo = 0.5;
