@@ -52,13 +52,9 @@ MaterialEvents choose_event_probabilities(EventProbabilities requested, const Ma
     c.scheme = requested;
     return c;
   }
-  // Auto is max for now. The rule measured in docs/results.md (implicit, or average where every bin
-  // absorbs more than it scatters) was 1.2–2× more efficient on the bench scenes, but with it two
-  // stress comparisons of spectral tracking against one wavelength per path (σt varying 1e4× across
-  // bins; 400 bins) differ by 5.3–5.8 standard errors, while max and mixed pass: until that is
-  // understood (a bias, or heavy-tailed lane weights that the variance estimate misses) the sum
-  // schemes are opt-in. kAbsorbingAlbedo and the measurements stay for `-v` and that next step.
-  c.scheme = EventProbabilities::Max;
+  // implicit, or max where every bin absorbs more than it scatters (docs/renderer.md, "Event
+  // probabilities": why, and the stress comparisons that once kept auto at max for every material).
+  c.scheme = c.albedo_max < kAbsorbingAlbedo ? EventProbabilities::Max : EventProbabilities::Implicit;
   return c;
 }
 

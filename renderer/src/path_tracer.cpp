@@ -560,30 +560,17 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
     const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
     const ConstLanes<kLanes> albedo = lanes_of<kLanes>(std::as_const(s.cache.albedo), n, m);
     const float mu = tc.mu;
-    // The three coefficients in one pass over the lanes (the hot loop of a render; the same float
-    // operations as the Lanes expressions ss = d·σt·α, sa = d·σt − ss, sn = max(0, μ̄ − d·σt)),
-    // then, for the default max scheme, their maxima.
+    // The three coefficients and the scheme's m_e (event_probability.h). The default max scheme
+    // takes its maxima after the coefficient loop, not in it: max_over's partial maxima vectorise,
+    // and so does the loop without them (a running max kept both scalar); the same bits (lanes.h,
+    // max_from_zero). The sum schemes add lane by lane in the same pass.
     EventCoefficients ev;
-    {
-      const float* __restrict st = sigma_t.data();
-      const float* __restrict al = albedo.data();
-      const float* __restrict wi = w.data();
-      float* __restrict pa = sa.data();
-      float* __restrict ps = ss.data();
-      float* __restrict pn = sn.data();
-      const bool max_scheme = m_events[m] == EventProbabilities::Max;
-      for (int i = 0; i < n; ++i) {
-        const float sig_t = d * st[i];
-        ps[i] = sig_t * al[i];
-        pa[i] = sig_t - ps[i];
-        pn[i] = std::max(0.0f, mu - sig_t);
-      }
-      // After the loop, not in it: max_over's partial maxima vectorise, and so does the loop
-      // without them (a running max kept both scalar); the same bits (lanes.h, max_from_zero).
-      if (max_scheme)
-        ev = EventCoefficients{.absorb = max_over(w * sa, n), .scatter = max_over(w * ss, n), .null = max_over(w * sn, n)};
-      else
-        ev = event_coefficients(m_events[m], n, wi, pa, ps, pn);
+    if (m_events[m] == EventProbabilities::Max) {
+      collision_lanes(n, d, mu, sigma_t.data(), albedo.data(), sa.data(), ss.data(), sn.data());
+      ev = EventCoefficients{.absorb = max_over(w * sa, n), .scatter = max_over(w * ss, n), .null = max_over(w * sn, n)};
+    } else {
+      ev = collision_coefficients(m_events[m], n, d, mu, sigma_t.data(), albedo.data(), w.data(), sa.data(),
+                                  ss.data(), sn.data());
     }
     const float ma = ev.absorb, ms = ev.scatter, mn = ev.null;
     float mf = 0.0f;

@@ -28,6 +28,8 @@ struct CaseOptions {
   // 1/bins of its samples; rare contributions then give skewed per-bin estimates whose sample
   // variance understates the error where few events were seen, so it gets more (cheap) samples.
   int single_factor = 1;
+  // With more than 8 bins: image means over groups of this many adjacent bins (expect_image_means_agree).
+  int bin_group = 1;
 };
 
 // The checks every case runs; returns the 4N spectral-tracking render.
@@ -50,7 +52,7 @@ ps::SpectralImage run_case(const pr::Scene& scene, const std::string& what, Case
     if (scene.settings.bins.size() <= 8)
       expect_agree(a4, b, what + ": spectral tracking vs single wavelength");
     else
-      expect_image_means_agree(a4, b, what + ": spectral tracking vs single wavelength (image means)");
+      expect_image_means_agree(a4, b, what + ": spectral tracking vs single wavelength (image means)", opt.bin_group);
   }
   if (opt.compare_no_grid) {
     const auto c = render_range(scene, 0, 4 * n, 3, pr::WavelengthSampling::SpectralTracking, false, &stats);
@@ -185,9 +187,11 @@ TEST(StressBins, OneBin) {
 
 TEST(StressBins, FourHundredBins) {
   // 1 nm bins over 380–780: per-pixel checks against the exact absorber; the one-wavelength method
-  // (about 1 sample per bin per 400) is compared through image means per bin.
+  // (1 sample per bin per 400) is compared through image means over 10 adjacent bins, with 64× the
+  // samples (at 16× and per bin its skewed estimates of the key light failed at 5–5.6 standard
+  // errors for several schemes and seeds, 2026-12-02: docs/results.md, "Numerical stress tests").
   auto s = slab_scene(box_medium({8, 8, 8}, chromatic_material()), true, 8, 400);
-  run_case(s, "400 bins", {.compare_single = true, .n = full_run() ? 256 : 64, .single_factor = 16});
+  run_case(s, "400 bins", {.compare_single = true, .n = full_run() ? 256 : 64, .single_factor = 64, .bin_group = 10});
   pr::Material absorber = chromatic_material();
   absorber.albedo = ps::Spectrum::constant(0.0);
   s = slab_scene(box_medium({8, 8, 8}, absorber), false, 8, 400);

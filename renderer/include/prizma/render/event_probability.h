@@ -43,7 +43,8 @@ struct MaterialEvents {
 // The auto rule (docs/renderer.md, "Event probabilities"), per material, since the scheme may change
 // from one collision to the next without bias: "implicit", except in a material that absorbs more
 // than it scatters in every bin (max_i α_i < kAbsorbingAlbedo), where implicit capture would walk
-// the path through the whole absorber: "average" there. Deterministic: a function of the material's
+// the path through the whole absorber: "max" there (average had 0.86× max's variance on the
+// metamer pair, docs/results.md). Deterministic: a function of the material's
 // spectra and the bins only. `requested` other than Auto is given to every material as it is (the
 // measurements still made).
 inline constexpr double kAbsorbingAlbedo = 0.5;
@@ -56,35 +57,95 @@ std::vector<MaterialEvents> choose_event_probabilities(EventProbabilities reques
 std::string describe_event_probabilities(const std::vector<MaterialEvents>& choice,
                                          const std::vector<Material>& materials);
 
-// m_e for the three events of a collision (the tracer's inner loop; inline so that it vectorises
-// with the loop that computes σ). Weights and coefficients are ≥ 0.
+// m_e for the three events of a collision. Weights and coefficients are ≥ 0.
 struct EventCoefficients {
   float absorb = 0.0f, scatter = 0.0f, null = 0.0f;
 };
 
+// The lanes' maxima and sums of w_i·σ_e,i that a scheme needs, added lane by lane in lane order,
+// and the scheme's m_e from them: the one place where the schemes are defined (inline: the
+// collision loop adds to it in its pass over the lanes).
+class EventTerms {
+ public:
+  explicit EventTerms(EventProbabilities scheme)
+      : m_scheme(scheme),
+        m_max(scheme == EventProbabilities::Max || scheme == EventProbabilities::Auto ||
+              scheme == EventProbabilities::Mixed),
+        m_sum(!(scheme == EventProbabilities::Max || scheme == EventProbabilities::Auto)) {}
+
+  // One lane: weight w, coefficients sa, ss, sn.
+  void add(float w, float sa, float ss, float sn) {
+    if (m_max) {
+      m_mx.absorb = std::max(m_mx.absorb, w * sa);
+      m_mx.scatter = std::max(m_mx.scatter, w * ss);
+      m_mx.null = std::max(m_mx.null, w * sn);
+    }
+    if (m_sum) {
+      m_sm.absorb += w * sa;
+      m_sm.scatter += w * ss;
+      m_sm.null += w * sn;
+    }
+  }
+
+  // m_e over the n lanes added.
+  EventCoefficients coefficients(int n) const {
+    switch (m_scheme) {
+      case EventProbabilities::Average: return m_sm;
+      case EventProbabilities::Implicit:  // one lane: analog tracking (its weight must stay exactly 1)
+        return {n > 1 ? 0.0f : m_sm.absorb, m_sm.scatter, m_sm.null};
+      case EventProbabilities::Mixed: {
+        const float k = 1.0f / static_cast<float>(n);
+        return {m_mx.absorb + k * m_sm.absorb, m_mx.scatter + k * m_sm.scatter, m_mx.null + k * m_sm.null};
+      }
+      default: return m_mx;  // Max (and Auto, which a material never keeps)
+    }
+  }
+
+ private:
+  EventProbabilities m_scheme;
+  bool m_max, m_sum;
+  EventCoefficients m_mx, m_sm;
+};
+
+// m_e from given per-lane weights and coefficients.
 inline EventCoefficients event_coefficients(EventProbabilities scheme, int n, const float* __restrict w,
                                             const float* __restrict sa, const float* __restrict ss,
                                             const float* __restrict sn) {
-  EventCoefficients mx, sum;
-  if (scheme != EventProbabilities::Average)
-    for (int i = 0; i < n; ++i) {
-      mx.absorb = std::max(mx.absorb, w[i] * sa[i]);
-      mx.scatter = std::max(mx.scatter, w[i] * ss[i]);
-      mx.null = std::max(mx.null, w[i] * sn[i]);
-    }
-  if (scheme == EventProbabilities::Max || scheme == EventProbabilities::Auto) return mx;
+  EventTerms t(scheme);
+  for (int i = 0; i < n; ++i) t.add(w[i], sa[i], ss[i], sn[i]);
+  return t.coefficients(n);
+}
+
+// A tentative collision at density d in a cell of majorant μ̄: lane i's coefficients
+// σs,i = d·σt,i·α_i, σa,i = d·σt,i − σs,i and σn,i = max(0, μ̄ − d·σt,i) (σt and α per unit density,
+// at the lane's wavelength). The formulas, once.
+inline void collision_lane(float density, float mu, float sigma_t, float albedo, float& sa, float& ss, float& sn) {
+  const float sig_t = density * sigma_t;
+  ss = sig_t * albedo;
+  sa = sig_t - ss;
+  sn = std::max(0.0f, mu - sig_t);
+}
+
+// Every lane's coefficients into sa, ss, sn, and nothing else: a loop that vectorises (the max
+// scheme takes its maxima after it, lanes.h max_over).
+inline void collision_lanes(int n, float density, float mu, const float* __restrict sigma_t,
+                            const float* __restrict albedo, float* __restrict sa, float* __restrict ss,
+                            float* __restrict sn) {
+  for (int i = 0; i < n; ++i) collision_lane(density, mu, sigma_t[i], albedo[i], sa[i], ss[i], sn[i]);
+}
+
+// The coefficients into sa, ss, sn and the scheme's m_e of them with the weights w, in one pass
+// over the lanes (the sum schemes: their sums stay in lane order).
+inline EventCoefficients collision_coefficients(EventProbabilities scheme, int n, float density, float mu,
+                                                const float* __restrict sigma_t, const float* __restrict albedo,
+                                                const float* __restrict w, float* __restrict sa,
+                                                float* __restrict ss, float* __restrict sn) {
+  EventTerms t(scheme);
   for (int i = 0; i < n; ++i) {
-    sum.absorb += w[i] * sa[i];
-    sum.scatter += w[i] * ss[i];
-    sum.null += w[i] * sn[i];
+    collision_lane(density, mu, sigma_t[i], albedo[i], sa[i], ss[i], sn[i]);
+    t.add(w[i], sa[i], ss[i], sn[i]);
   }
-  if (scheme == EventProbabilities::Average) return sum;
-  if (scheme == EventProbabilities::Implicit) {
-    if (n > 1) sum.absorb = 0.0f;  // one lane: analog tracking (its weight must stay exactly 1)
-    return sum;
-  }
-  const float k = 1.0f / static_cast<float>(n);
-  return {mx.absorb + k * sum.absorb, mx.scatter + k * sum.scatter, mx.null + k * sum.null};
+  return t.coefficients(n);
 }
 
 // m_e of one more event whose coefficient is d·x_i (fluorescence), by the same scheme.
