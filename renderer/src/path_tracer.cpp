@@ -560,18 +560,10 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
     const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
     const ConstLanes<kLanes> albedo = lanes_of<kLanes>(std::as_const(s.cache.albedo), n, m);
     const float mu = tc.mu;
-    // The three coefficients and the scheme's m_e (event_probability.h). The default max scheme
-    // takes its maxima after the coefficient loop, not in it: max_over's partial maxima vectorise,
-    // and so does the loop without them (a running max kept both scalar); the same bits (lanes.h,
-    // max_from_zero). The sum schemes add lane by lane in the same pass.
-    EventCoefficients ev;
-    if (m_events[m] == EventProbabilities::Max) {
-      collision_lanes(n, d, mu, sigma_t.data(), albedo.data(), sa.data(), ss.data(), sn.data());
-      ev = EventCoefficients{.absorb = max_over(w * sa, n), .scatter = max_over(w * ss, n), .null = max_over(w * sn, n)};
-    } else {
-      ev = collision_coefficients(m_events[m], n, d, mu, sigma_t.data(), albedo.data(), w.data(), sa.data(),
-                                  ss.data(), sn.data());
-    }
+    // The three coefficients in one loop over the lanes, then the scheme's m_e in fixed-order partial
+    // maxima and sums: both vectorise, with the same bits at every SIMD level (event_probability.h).
+    const EventCoefficients ev = collision_coefficients(m_events[m], n, d, mu, sigma_t.data(), albedo.data(),
+                                                        w.data(), sa.data(), ss.data(), sn.data());
     const float ma = ev.absorb, ms = ev.scatter, mn = ev.null;
     float mf = 0.0f;
     if (m_fluorescent[m]) {

@@ -62,58 +62,60 @@ struct EventCoefficients {
   float absorb = 0.0f, scatter = 0.0f, null = 0.0f;
 };
 
-// The lanes' maxima and sums of w_i·σ_e,i that a scheme needs, added lane by lane in lane order,
-// and the scheme's m_e from them: the one place where the schemes are defined (inline: the
-// collision loop adds to it in its pass over the lanes).
-class EventTerms {
- public:
-  explicit EventTerms(EventProbabilities scheme)
-      : m_scheme(scheme),
-        m_max(scheme == EventProbabilities::Max || scheme == EventProbabilities::Auto ||
-              scheme == EventProbabilities::Mixed),
-        m_sum(!(scheme == EventProbabilities::Max || scheme == EventProbabilities::Auto)) {}
+namespace event_detail {
 
-  // One lane: weight w, coefficients sa, ss, sn.
-  void add(float w, float sa, float ss, float sn) {
-    if (m_max) {
-      m_mx.absorb = std::max(m_mx.absorb, w * sa);
-      m_mx.scatter = std::max(m_mx.scatter, w * ss);
-      m_mx.null = std::max(m_mx.null, w * sn);
-    }
-    if (m_sum) {
-      m_sm.absorb += w * sa;
-      m_sm.scatter += w * ss;
-      m_sm.null += w * sn;
-    }
+// Partial maxima and sums over the lanes: lane i goes into partial i mod kWidth, in lane order, and
+// the partials are combined in order at the end. The order is fixed, so every SIMD level of the
+// tracer gives the same bits (no -ffast-math, no FMA contraction: tests/render/test_simd_levels.cpp),
+// and the loops vectorise, which a single running float sum or max does not. A maximum is
+// max(+0, the largest w_i·x_i) whatever the order (as lanes.h max_from_zero).
+constexpr int kWidth = 8;
+
+inline float weighted_max(int n, const float* __restrict w, const float* __restrict x, float d) {
+  float part[kWidth] = {};
+  int i = 0;
+  for (; i + kWidth <= n; i += kWidth)
+    for (int k = 0; k < kWidth; ++k) part[k] = std::max(part[k], w[i + k] * d * x[i + k]);
+  for (int k = 0; i < n; ++i, ++k) part[k] = std::max(part[k], w[i] * d * x[i]);
+  float m = 0.0f;
+  for (int k = 0; k < kWidth; ++k) m = std::max(m, part[k]);
+  return m;
+}
+
+inline float weighted_sum(int n, const float* __restrict w, const float* __restrict x, float d) {
+  float part[kWidth] = {};
+  int i = 0;
+  for (; i + kWidth <= n; i += kWidth)
+    for (int k = 0; k < kWidth; ++k) part[k] += w[i + k] * d * x[i + k];
+  for (int k = 0; i < n; ++i, ++k) part[k] += w[i] * d * x[i];
+  float sum = 0.0f;
+  for (int k = 0; k < kWidth; ++k) sum += part[k];
+  return sum;
+}
+
+// A scheme's m_e from the maximum and the sum of w_i·d·x_i over n lanes (d = 1 but for
+// fluorescence; w·1 is exactly w): the one place where the schemes are defined.
+inline float scheme_coefficient(EventProbabilities scheme, int n, const float* __restrict w, const float* __restrict x,
+                                float d = 1.0f) {
+  switch (scheme) {
+    case EventProbabilities::Average:
+    case EventProbabilities::Implicit: return weighted_sum(n, w, x, d);
+    case EventProbabilities::Mixed: return weighted_max(n, w, x, d) + weighted_sum(n, w, x, d) / static_cast<float>(n);
+    default: return weighted_max(n, w, x, d);  // Max (and Auto, which a material never keeps)
   }
+}
 
-  // m_e over the n lanes added.
-  EventCoefficients coefficients(int n) const {
-    switch (m_scheme) {
-      case EventProbabilities::Average: return m_sm;
-      case EventProbabilities::Implicit:  // one lane: analog tracking (its weight must stay exactly 1)
-        return {n > 1 ? 0.0f : m_sm.absorb, m_sm.scatter, m_sm.null};
-      case EventProbabilities::Mixed: {
-        const float k = 1.0f / static_cast<float>(n);
-        return {m_mx.absorb + k * m_sm.absorb, m_mx.scatter + k * m_sm.scatter, m_mx.null + k * m_sm.null};
-      }
-      default: return m_mx;  // Max (and Auto, which a material never keeps)
-    }
-  }
+}  // namespace event_detail
 
- private:
-  EventProbabilities m_scheme;
-  bool m_max, m_sum;
-  EventCoefficients m_mx, m_sm;
-};
-
-// m_e from given per-lane weights and coefficients.
+// m_e from given per-lane weights and coefficients. Under `implicit` absorption is left to the
+// weights (m_a = 0), except with one lane: analog tracking, whose weight must stay exactly 1.
 inline EventCoefficients event_coefficients(EventProbabilities scheme, int n, const float* __restrict w,
                                             const float* __restrict sa, const float* __restrict ss,
                                             const float* __restrict sn) {
-  EventTerms t(scheme);
-  for (int i = 0; i < n; ++i) t.add(w[i], sa[i], ss[i], sn[i]);
-  return t.coefficients(n);
+  using event_detail::scheme_coefficient;
+  const bool implicit_absorption = scheme == EventProbabilities::Implicit && n > 1;
+  return {implicit_absorption ? 0.0f : scheme_coefficient(scheme, n, w, sa), scheme_coefficient(scheme, n, w, ss),
+          scheme_coefficient(scheme, n, w, sn)};
 }
 
 // A tentative collision at density d in a cell of majorant μ̄: lane i's coefficients
@@ -126,42 +128,27 @@ inline void collision_lane(float density, float mu, float sigma_t, float albedo,
   sn = std::max(0.0f, mu - sig_t);
 }
 
-// Every lane's coefficients into sa, ss, sn, and nothing else: a loop that vectorises (the max
-// scheme takes its maxima after it, lanes.h max_over).
+// Every lane's coefficients into sa, ss, sn, and nothing else: a loop that vectorises (the
+// reductions come after it).
 inline void collision_lanes(int n, float density, float mu, const float* __restrict sigma_t,
                             const float* __restrict albedo, float* __restrict sa, float* __restrict ss,
                             float* __restrict sn) {
   for (int i = 0; i < n; ++i) collision_lane(density, mu, sigma_t[i], albedo[i], sa[i], ss[i], sn[i]);
 }
 
-// The coefficients into sa, ss, sn and the scheme's m_e of them with the weights w, in one pass
-// over the lanes (the sum schemes: their sums stay in lane order).
+// The coefficients into sa, ss, sn, then the scheme's m_e of them with the weights w.
 inline EventCoefficients collision_coefficients(EventProbabilities scheme, int n, float density, float mu,
                                                 const float* __restrict sigma_t, const float* __restrict albedo,
                                                 const float* __restrict w, float* __restrict sa,
                                                 float* __restrict ss, float* __restrict sn) {
-  EventTerms t(scheme);
-  for (int i = 0; i < n; ++i) {
-    collision_lane(density, mu, sigma_t[i], albedo[i], sa[i], ss[i], sn[i]);
-    t.add(w[i], sa[i], ss[i], sn[i]);
-  }
-  return t.coefficients(n);
+  collision_lanes(n, density, mu, sigma_t, albedo, sa, ss, sn);
+  return event_coefficients(scheme, n, w, sa, ss, sn);
 }
 
 // m_e of one more event whose coefficient is d·x_i (fluorescence), by the same scheme.
 inline float event_coefficient(EventProbabilities scheme, int n, const float* __restrict w, float d,
                                const float* __restrict x) {
-  float mx = 0.0f, sum = 0.0f;
-  for (int i = 0; i < n; ++i) {
-    mx = std::max(mx, w[i] * d * x[i]);
-    sum += w[i] * d * x[i];
-  }
-  switch (scheme) {
-    case EventProbabilities::Average:
-    case EventProbabilities::Implicit: return sum;
-    case EventProbabilities::Mixed: return mx + sum / static_cast<float>(n);
-    default: return mx;
-  }
+  return event_detail::scheme_coefficient(scheme, n, w, x, d);
 }
 
 }  // namespace prizma::render
