@@ -237,12 +237,17 @@ def channel_nm(nm):
 def check_excitation_emission_map(browser, srv, exr):
     """The probe's map on the page: the pixel's M[out][in] of the chosen light, as the file holds them,
     the largest cell drawn in the ramp's top colour."""
+    import numpy as np
     info = json.loads(http(srv.url + "api/info")[1])
     edges = info["bins"]
     centre = lambda b: 0.5 * (edges[b] + edges[b + 1])
     channels = read_exr_channels(exr)
-    x, y = info["width"] // 2, info["height"] // 2
     for light in [l["name"] for l in info["lights"]]:
+        # The pixel where this light's re-radiation is largest: at a few samples per pixel a given
+        # pixel may have seen none for a dim light (all pairs 0), and the check below is of the drawing.
+        pairs = [n for n in channels if n.startswith(light + ".T.") and n.count(".") == 3 and n.endswith("nm")]
+        rerad = sum(channels[n] for n in pairs)
+        y, x = (int(v) for v in np.unravel_index(np.argmax(rerad), rerad.shape))
         browser.execute_script("document.getElementById('eemlight').value = arguments[0]; probe(arguments[1], arguments[2]);",
                                light, x, y)
         deadline = time.time() + 30
