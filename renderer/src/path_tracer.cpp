@@ -473,7 +473,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
     if (m != run_material) {
       flush();
       run_material = m;
-      if (s.cache.stamp[m] != s.cache.path_id) evaluate_material(m, s);
+      if (!s.cache.holds(m)) evaluate_material(m, s);
       const float* st = s.cache.sigma_t.data() + static_cast<std::size_t>(m) * n;
       run_sigma_min = st[0];
       for (int i = 1; i < n; ++i) run_sigma_min = std::min(run_sigma_min, st[i]);
@@ -495,7 +495,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
       if (m == Medium::kEmpty || d <= 0.0f) d = 0.0f;
       if (mc == CellControl::kNone) {  // plain ratio tracking: T *= 1 − σt/μ̄
         if (d == 0.0f) return true;
-        if (s.cache.stamp[m] != s.cache.path_id) evaluate_material(m, s);
+        if (!s.cache.holds(m)) evaluate_material(m, s);
         const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
         T *= lane_max(0.0f, 1.0f - (d * tc.inv_mu) * sigma_t);
       } else {  // another material than the control's (only on a cell's boundary, by rounding)
@@ -504,7 +504,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
         if (d == 0.0f) {
           T *= 1.0f + kc * sigma_c;
         } else {
-          if (s.cache.stamp[m] != s.cache.path_id) evaluate_material(m, s);
+          if (!s.cache.holds(m)) evaluate_material(m, s);
           const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
           T *= lane_max(0.0f, 1.0f - ((d * tc.inv_mu) * sigma_t - kc * sigma_c));
         }
@@ -525,10 +525,7 @@ void PathTracer::estimate_transmittance(const Eigen::Vector3d& origin, const Eig
                                         Rng& rng, PathScratch& s) const {
   MaterialCache& cache = s.cache;
   std::copy(s.in.lambda_nm.begin(), s.in.lambda_nm.end(), cache.lambda_nm.begin());
-  if (++cache.path_id == 0) {  // wrapped: forget every stamp
-    std::fill(cache.stamp.begin(), cache.stamp.end(), 0u);
-    cache.path_id = 1;
-  }
+  cache.new_wavelengths();
   if (s.lanes == 1)
     transmittance<1>(origin, dir, rng, s, t_max);
   else
@@ -556,7 +553,7 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
     float d;
     lookup(tc.p, m, d);
     if (m == Medium::kEmpty || d <= 0.0f) return true;  // σt = 0: a null collision of weight 1
-    if (s.cache.stamp[m] != s.cache.path_id) evaluate_material(m, s);
+    if (!s.cache.holds(m)) evaluate_material(m, s);
     const ConstLanes<kLanes> sigma_t = lanes_of<kLanes>(std::as_const(s.cache.sigma_t), n, m);
     const ConstLanes<kLanes> albedo = lanes_of<kLanes>(std::as_const(s.cache.albedo), n, m);
     const float mu = tc.mu;
@@ -711,11 +708,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   const int n = lane_count<kLanes>(s);
   MaterialCache& cache = s.cache;
   std::copy(s.in.lambda_nm.begin(), s.in.lambda_nm.end(), cache.lambda_nm.begin());
-  ++cache.path_id;
-  if (cache.path_id == 0) {  // wrapped: forget every stamp
-    std::fill(cache.stamp.begin(), cache.stamp.end(), 0u);
-    cache.path_id = 1;
-  }
+  cache.new_wavelengths();
   PathResult& out = s.out;
   PathState<kLanes> v{n, lanes_of<kLanes>(s.work.weight, n), out.environment.data(), out.emission.data(),
                       out.directional.data(), camera_ray.origin, camera_ray.direction};
@@ -784,10 +777,7 @@ void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch&
     const float event = w0 * density * cache.fl_out[static_cast<std::size_t>(m)] * k;
     const ExcitationSampler::Draw draw = m_fl_excitation[m].sample(rng.uniform_double());
     cache.lambda_nm[0] = static_cast<float>(draw.lambda_nm);
-    if (++cache.path_id == 0) {  // every material is evaluated anew at the new wavelength
-      std::fill(cache.stamp.begin(), cache.stamp.end(), 0u);
-      cache.path_id = 1;
-    }
+    cache.new_wavelengths();  // every material is evaluated anew at the new wavelength
     if (!out.fl_active) {
       out.fl_a[0] = event;
       std::fill(out.fl_environment.begin(), out.fl_environment.end(), 0.0f);
@@ -811,10 +801,7 @@ void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch&
     total = sum_over(w * density * fo * k, n);
   const double u = rng.uniform_double();
   for (int i = 0; i < n; ++i) cache.lambda_nm[i] = static_cast<float>(s.in.lo_nm[i] + u * s.in.width_nm[i]);
-  if (++cache.path_id == 0) {  // every material is evaluated anew at the new wavelengths
-    std::fill(cache.stamp.begin(), cache.stamp.end(), 0u);
-    cache.path_id = 1;
-  }
+  cache.new_wavelengths();  // every material is evaluated anew at the new wavelengths
   evaluate_material(m, s);
   const auto ratio = static_cast<float>(old_sum > 0.0 ? cache.fl_lambda_sum[m] / old_sum : 0.0);
   const ConstLanes<0> fi = lanes_of<0>(std::as_const(cache.fl_in), n, m);

@@ -6,6 +6,7 @@
 // unit environment, from each directional light of unit irradiance (unit white spectra), and the
 // radiance the medium emits (the emission light).
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -54,6 +55,15 @@ struct MaterialCache {
   std::vector<float> emission_le;  // [material][lanes] emitted radiance at density 1 (emitting materials)
   std::vector<std::uint32_t> stamp;  // [material] path id that last evaluated it
   std::uint32_t path_id = 0;
+  // The wavelengths changed (a new path, or a fluorescent event): every material is evaluated anew
+  // when next met. A new id, and on the id's wrap-around every stamp forgotten.
+  void new_wavelengths() {
+    if (++path_id == 0) {
+      std::fill(stamp.begin(), stamp.end(), 0u);
+      path_id = 1;
+    }
+  }
+  bool holds(std::size_t material) const { return stamp[material] == path_id; }
   // Fluorescent materials (see PathTracer::evaluate_fluorescence).
   std::vector<double> fl_lambda_sum;  // [material] Λ = Σ_j Δj·σf(λj)·λj
   std::vector<float> fl_out;          // [material][lanes] Φ_i = q·ρ(λi)/λi·Λ per unit density
