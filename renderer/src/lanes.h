@@ -11,6 +11,8 @@
 #include <concepts>
 #include <type_traits>
 
+#include "prizma/render/partial_reduce.h"
+
 namespace prizma::render {
 
 template <int kN>
@@ -80,24 +82,6 @@ auto hold(const T& x) {
     return x;
 }
 
-// Largest of x[0..n) and 0, the same bits as the sequential loop m = std::max(m, x[i]) from
-// m = 0, but in kWidth partial maxima that GCC vectorises (a sequential float max it does not,
-// without -ffast-math). Order does not matter here: every partial starts at +0 and std::max(m, x)
-// never takes a NaN, nor −0 over +0, so the result is max(+0, the largest non-NaN x[i]), and equal
-// values other than zeros have equal bits.
-template <class X>
-float max_from_zero(const X& x, int n) {
-  constexpr int kWidth = 8;
-  float part[kWidth] = {};
-  int i = 0;
-  for (; i + kWidth <= n; i += kWidth)
-    for (int k = 0; k < kWidth; ++k) part[k] = std::max(part[k], x[i + k]);
-  for (; i < n; ++i) part[0] = std::max(part[0], x[i]);
-  float m = 0.0f;
-  for (int k = 0; k < kWidth; ++k) m = std::max(m, part[k]);
-  return m;
-}
-
 template <class Op, class A, class B>
 auto make(const A& a, const B& b) {
   return Binary<Op, decltype(hold(a)), decltype(hold(b))>{hold(a), hold(b)};
@@ -114,7 +98,7 @@ class ConstLanes {
   float operator[](int i) const { return m_data[i]; }
   const float* data() const { return m_data; }
   // Largest lane value and 0 (0 for no lanes; a NaN lane is never taken).
-  float max() const { return lanes_detail::max_from_zero(m_data, size()); }
+  float max() const { return partial::max_from_zero(m_data, size()); }
   // Σ lanes in lane order.
   float sum() const {
     float s = 0.0f;
@@ -196,7 +180,7 @@ auto lane_map(F f, const A& a) {
 // Largest value of an expression over n lanes and 0 (as ConstLanes::max, without storing it).
 template <lanes_detail::LaneExpr E>
 float max_over(const E& e, int n) {
-  return lanes_detail::max_from_zero(lanes_detail::hold(e), n);
+  return partial::max_from_zero(lanes_detail::hold(e), n);
 }
 // Σ over n lanes of an expression, in lane order.
 template <lanes_detail::LaneExpr E>

@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "prizma/render/partial_reduce.h"
 #include "prizma/spectral/bin_layout.h"
 
 namespace prizma::render {
@@ -64,44 +65,27 @@ struct EventCoefficients {
 
 namespace event_detail {
 
-// Partial maxima and sums over the lanes: lane i goes into partial i mod kWidth, in lane order, and
-// the partials are combined in order at the end. The order is fixed, so every SIMD level of the
-// tracer gives the same bits (no -ffast-math, no FMA contraction: tests/render/test_simd_levels.cpp),
-// and the loops vectorise, which a single running float sum or max does not. A maximum is
-// max(+0, the largest w_i·x_i) whatever the order (as lanes.h max_from_zero).
-constexpr int kWidth = 8;
-
-inline float weighted_max(int n, const float* __restrict w, const float* __restrict x, float d) {
-  float part[kWidth] = {};
-  int i = 0;
-  for (; i + kWidth <= n; i += kWidth)
-    for (int k = 0; k < kWidth; ++k) part[k] = std::max(part[k], w[i + k] * d * x[i + k]);
-  for (int k = 0; i < n; ++i, ++k) part[k] = std::max(part[k], w[i] * d * x[i]);
-  float m = 0.0f;
-  for (int k = 0; k < kWidth; ++k) m = std::max(m, part[k]);
-  return m;
-}
-
-inline float weighted_sum(int n, const float* __restrict w, const float* __restrict x, float d) {
-  float part[kWidth] = {};
-  int i = 0;
-  for (; i + kWidth <= n; i += kWidth)
-    for (int k = 0; k < kWidth; ++k) part[k] += w[i + k] * d * x[i + k];
-  for (int k = 0; i < n; ++i, ++k) part[k] += w[i] * d * x[i];
-  float sum = 0.0f;
-  for (int k = 0; k < kWidth; ++k) sum += part[k];
-  return sum;
-}
+// w_i·d·x_i, as partial::max_from_zero and partial::sum read it.
+struct WeightedLanes {
+  const float* __restrict w;
+  const float* __restrict x;
+  float d;
+  float operator[](int i) const { return w[i] * d * x[i]; }
+};
 
 // A scheme's m_e from the maximum and the sum of w_i·d·x_i over n lanes (d = 1 but for
-// fluorescence; w·1 is exactly w): the one place where the schemes are defined.
+// fluorescence; w·1 is exactly w), in partial results (partial_reduce.h: vectorised, the same bits
+// at every SIMD level): the one place where the schemes are defined.
 inline float scheme_coefficient(EventProbabilities scheme, int n, const float* __restrict w, const float* __restrict x,
                                 float d = 1.0f) {
   switch (scheme) {
     case EventProbabilities::Average:
-    case EventProbabilities::Implicit: return weighted_sum(n, w, x, d);
-    case EventProbabilities::Mixed: return weighted_max(n, w, x, d) + weighted_sum(n, w, x, d) / static_cast<float>(n);
-    default: return weighted_max(n, w, x, d);  // Max (and Auto, which a material never keeps)
+    case EventProbabilities::Implicit: return partial::sum(WeightedLanes{w, x, d}, n);
+    case EventProbabilities::Mixed:
+      return partial::max_from_zero(WeightedLanes{w, x, d}, n) +
+             partial::sum(WeightedLanes{w, x, d}, n) / static_cast<float>(n);
+    default:  // Max (and Auto, which a material never keeps)
+      return partial::max_from_zero(WeightedLanes{w, x, d}, n);
   }
 }
 
