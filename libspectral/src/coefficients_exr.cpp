@@ -41,17 +41,9 @@ constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
 constexpr std::uint64_t kFnvBasisCoefficients = 0x9ce484222325cbf2ULL;
 constexpr std::uint64_t kFnvBasisVectors = 0x484222325cbf29ceULL;
 
-std::uint64_t hash_floats(const float* v, std::size_t n, std::uint64_t h) {
-  for (std::size_t i = 0; i < n; ++i) {
-    std::uint32_t bits;
-    std::memcpy(&bits, &v[i], sizeof bits);
-    h = (h ^ bits) * kFnvPrime;
-  }
-  return h;
-}
-
-// The same for half values as a reader gets them (each converted to float).
-std::uint64_t hash_halves(const half* v, std::size_t n, std::uint64_t h) {
+// FNV-1a over the float bits of v (float, or half as a reader gets it: each converted to float).
+template <class T>
+std::uint64_t hash_floats(const T* v, std::size_t n, std::uint64_t h) {
   for (std::size_t i = 0; i < n; ++i) {
     const float f = v[i];
     std::uint32_t bits;
@@ -60,6 +52,7 @@ std::uint64_t hash_halves(const half* v, std::size_t n, std::uint64_t h) {
   }
   return h;
 }
+
 
 // Refuses coefficients that half cannot hold (|v| rounds past 65504).
 void check_half_range(const std::vector<float>& v, std::size_t k, std::size_t width, const std::string& what,
@@ -135,7 +128,7 @@ std::uint64_t add_coefficients_for_write(const SpectralImage& image, bool multi,
       fb.insert(name, Imf::Slice(Imf::HALF, const_cast<char*>(base + sizeof(half) * j), x_stride, y_stride));
     }
     header.insert(kAttrBasisPrefix + light.name, Imf::FloatVectorAttribute(Imf::FloatVector(c.basis.begin(), c.basis.end())));
-    sum += hash_halves(rounded.data(), rounded.size(), kFnvBasisCoefficients);
+    sum += hash_floats(rounded.data(), rounded.size(), kFnvBasisCoefficients);
     sum += hash_floats(c.basis.data(), c.basis.size(), kFnvBasisVectors);
     nlohmann::json errors = nlohmann::json::array();
     for (const BasisError& e : c.errors) errors.push_back({{"light", e.light}, {"percentile", e.percentile}, {"max", e.max}});
