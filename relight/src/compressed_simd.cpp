@@ -96,10 +96,17 @@ HWY_INLINE void block(const SimdCoeffLayer* layers, int layer_count, const std::
 
 }  // namespace
 
+void HalfToFloat(const std::uint16_t* in, std::size_t count, float* out) {
+  const DF d;
+  const DH dh;
+  std::size_t i = 0;
+  for (; i + hn::Lanes(d) <= count; i += hn::Lanes(d)) hn::StoreU(widen(hn::LoadU(dh, in + i)), d, out + i);
+  for (; i < count; ++i) out[i] = hn::GetLane(widen(hn::Set(dh, in[i])));
+}
+
 void CompressedRowToDisplay8(const SimdCoeffLayer* layers, int layer_count, std::size_t first_pixel, int width,
                              const SimdEncoder& e, float* scratch, std::uint8_t* out) {
   const DF d;
-  const DH dh;
   const int lanes = static_cast<int>(hn::Lanes(d));
   const int count = std::min(layer_count, kMaxFusedLayers);  // the caller's limit
   const std::uint16_t* coeff[kMaxFusedLayers];
@@ -113,9 +120,7 @@ void CompressedRowToDisplay8(const SimdCoeffLayer* layers, int layer_count, std:
     big[l] = nullptr;
     if (k > 4) {
       const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(k);
-      std::size_t i = 0;
-      for (; i + hn::Lanes(d) <= n; i += hn::Lanes(d)) hn::StoreU(widen(hn::LoadU(dh, c + i)), d, s + i);
-      for (; i < n; ++i) s[i] = hn::GetLane(widen(hn::Set(dh, c[i])));
+      HalfToFloat(c, n, s);
       std::fill(s + n, s + n + static_cast<std::size_t>(kMaxSimdLanes) * static_cast<std::size_t>(k), 0.0f);
       big[l] = s;
       s += static_cast<std::size_t>(width + kMaxSimdLanes) * static_cast<std::size_t>(k);
@@ -143,13 +148,6 @@ void CompressedRowToDisplay8(const SimdCoeffLayer* layers, int layer_count, std:
   }
 }
 
-void HalfToFloat(const std::uint16_t* in, std::size_t count, float* out) {
-  const DF d;
-  const DH dh;
-  std::size_t i = 0;
-  for (; i + hn::Lanes(d) <= count; i += hn::Lanes(d)) hn::StoreU(widen(hn::LoadU(dh, in + i)), d, out + i);
-  for (; i < count; ++i) out[i] = hn::GetLane(widen(hn::Set(dh, in[i])));
-}
 
 }  // namespace prizma::relight::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
