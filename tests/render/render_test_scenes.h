@@ -89,6 +89,16 @@ inline void randomise_density(Scene& s, float lo, float hi, unsigned seed = 3) {
   for (float& d : s.medium.density) d = dist(gen);
 }
 
+// The chromatic white furnace: albedo 1, σt from 6 to 1 per unit and HG g from g400 to g700 over
+// 400–700 nm, a 6³ random density field in [0.2, 2], unit environment: every bin's expectation is 1.
+inline Scene chromatic_furnace(double g400, double g700, int pixels, std::int64_t spp) {
+  Scene s = box_scene(make_material(spectral::Spectrum::constant(1.0), spectral::Spectrum({400.0, 700.0}, {6.0, 1.0}),
+                                    spectral::Spectrum({400.0, 700.0}, {g400, g700})),
+                      6, pixels, spp);
+  randomise_density(s, 0.2f, 2.0f);
+  return s;
+}
+
 // A small chromatic heterogeneous box (wavelength-dependent albedo and extinction, random density)
 // under one directional light: the determinism and resume tests' scene.
 inline Scene chromatic_scene(std::int64_t spp) {

@@ -151,10 +151,7 @@ TEST(EventProbability, BeerLambertPerBinForEveryScheme) {
 TEST(EventProbability, ChromaticFurnaceIsOneForEveryScheme) {
   // Albedo 1, σt and g depending on λ, heterogeneous density: 1 in every bin.
   for (EventProbabilities e : kSchemes) {
-    Scene s = box_scene(make_material(Spectrum::constant(1.0), Spectrum({400.0, 700.0}, {6.0, 1.0}),
-                                      Spectrum({400.0, 700.0}, {0.6, 0.3})),
-                        6, 8, 64);
-    testing::randomise_density(s, 0.2f, 2.0f);
+    Scene s = testing::chromatic_furnace(0.6, 0.3, 8, 64);
     s.settings.event_probabilities = e;
     const auto m = pixel_average(render(s), 0);
     for (int i = 0; i < 6; ++i)

@@ -64,10 +64,7 @@ TEST(RenderPhysics, WhiteFurnaceChromaticWithinNoise) {
   // Albedo 1 with σt and g depending on λ: spectral tracking's weights are no longer 1 per path, but
   // the expectation still is 1 in every bin.
   for (double g : {-0.9, 0.0, 0.9}) {
-    Scene s = box_scene(make_material(Spectrum::constant(1.0), Spectrum({400.0, 700.0}, {6.0, 1.0}),
-                                      Spectrum({400.0, 700.0}, {g, g * 0.5})),
-                        6, 8, 64);
-    testing::randomise_density(s, 0.2f, 2.0f);
+    Scene s = testing::chromatic_furnace(g, g * 0.5, 8, 64);
     RenderStats stats;
     const auto img = render(s, {}, &stats);
     EXPECT_FALSE(stats.wavelength_independent);

@@ -203,10 +203,7 @@ TEST(Sampler, SobolChromaticFurnaceIsOne) {
   // expectation is 1 (as RenderPhysics.WhiteFurnaceChromaticWithinNoise), here with paths that
   // scatter past the Sobol' dimensions into the PCG stream.
   for (double g : {-0.9, 0.0, 0.9}) {
-    Scene s = box_scene(make_material(Spectrum::constant(1.0), Spectrum({400.0, 700.0}, {6.0, 1.0}),
-                                      Spectrum({400.0, 700.0}, {g, g * 0.5})),
-                        6, 16, 16);
-    testing::randomise_density(s, 0.2f, 2.0f);
+    Scene s = testing::chromatic_furnace(g, g * 0.5, 16, 16);
     s.settings.sampler = Sampler::Sobol;
     const PixelSpread e = pixel_spread(render(s), std::vector<double>(6, 1.0));
     for (int i = 0; i < 6; ++i) {
