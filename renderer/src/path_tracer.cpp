@@ -364,11 +364,19 @@ void PathTracer::trace_baseline(const Ray& ray, Rng& rng, PathScratch& s) const 
 // -ffast-math), and the few calls that stay calls (libm, spectra, light samplers) are the same
 // functions at every level. tests/render/test_simd_levels.cpp compares the levels bit for bit.
 #if defined(__x86_64__) && defined(__GNUC__)
+// 256-bit vectors on the AVX-512 level: GCC takes the preference in the target string; clang does
+// not know it there (it warns and ignores the whole attribute), so its AVX-512 level keeps clang's
+// default width. Only the sanitizer tree is built with clang.
+#if defined(__clang__)
+#define PRIZMA_TRACE_AVX512_TARGET "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"
+#else
+#define PRIZMA_TRACE_AVX512_TARGET "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq,prefer-vector-width=256"
+#endif
 __attribute__((target("avx2,fma"), flatten)) void PathTracer::trace_avx2(const Ray& ray, Rng& rng,
                                                                           PathScratch& s) const {
   trace_baseline(ray, rng, s);
 }
-__attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq,prefer-vector-width=256"), flatten)) void PathTracer::trace_avx512(
+__attribute__((target(PRIZMA_TRACE_AVX512_TARGET), flatten)) void PathTracer::trace_avx512(
     const Ray& ray, Rng& rng, PathScratch& s) const {
   trace_baseline(ray, rng, s);
 }
@@ -376,6 +384,7 @@ __attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq,prefer-vector
 void PathTracer::trace_avx2(const Ray& ray, Rng& rng, PathScratch& s) const { trace_baseline(ray, rng, s); }
 void PathTracer::trace_avx512(const Ray& ray, Rng& rng, PathScratch& s) const { trace_baseline(ray, rng, s); }
 #endif
+#undef PRIZMA_TRACE_AVX512_TARGET
 
 // The state of a path between its events.
 template <int kLanes>
