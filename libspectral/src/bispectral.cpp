@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "bispectral_exr.h"
+#include "float_hash.h"
 #include "prizma/spectral/error.h"
 #include "text_util.h"
 
@@ -22,7 +23,6 @@ namespace {
 
 constexpr double kSpeedOfLight_m_per_s = 299792458.0;
 constexpr float kHalfMax = 65504.0f;
-constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
 // Offset basis of the bispectral values (the diagonal's cbf29ce484222325 rotated by 16 bits).
 constexpr std::uint64_t kFnvBasisReradiation = 0x2325cbf29ce48422ULL;
 
@@ -47,15 +47,7 @@ double to_nm(const std::string& name, std::string number, const std::string& pre
   return nm;
 }
 
-std::uint64_t hash_values(const float* v, std::size_t n) {
-  std::uint64_t h = kFnvBasisReradiation;
-  for (std::size_t k = 0; k < n; ++k) {
-    std::uint32_t bits;
-    std::memcpy(&bits, &v[k], sizeof bits);
-    h = (h ^ bits) * kFnvPrime;
-  }
-  return h;
-}
+std::uint64_t hash_values(const float* v, std::size_t n) { return detail::hash_float_bits(v, n, kFnvBasisReradiation); }
 
 std::string pair_text(const SpectralImage& image, const BinPair& pr) {
   std::ostringstream os;

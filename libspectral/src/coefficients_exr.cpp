@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "prizma/spectral/error.h"
+#include "float_hash.h"
 
 namespace prizma::spectral {
 
@@ -36,23 +37,9 @@ namespace {
 constexpr const char* kAttrInfo = "prizma:coefficients";
 constexpr const char* kAttrBasisPrefix = "prizma:basis.";
 constexpr int kMaxK = 1024;  // at most one coefficient per bin
-constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
 // Offset bases of the coefficients (pixel-major, k contiguous) and of the basis vectors (vector-major).
 constexpr std::uint64_t kFnvBasisCoefficients = 0x9ce484222325cbf2ULL;
 constexpr std::uint64_t kFnvBasisVectors = 0x484222325cbf29ceULL;
-
-// FNV-1a over the float bits of v (float, or half as a reader gets it: each converted to float).
-template <class T>
-std::uint64_t hash_floats(const T* v, std::size_t n, std::uint64_t h) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const float f = v[i];
-    std::uint32_t bits;
-    std::memcpy(&bits, &f, sizeof bits);
-    h = (h ^ bits) * kFnvPrime;
-  }
-  return h;
-}
-
 
 // Refuses coefficients that half cannot hold (|v| rounds past 65504).
 void check_half_range(const std::vector<float>& v, std::size_t k, std::size_t width, const std::string& what,
@@ -128,8 +115,8 @@ std::uint64_t add_coefficients_for_write(const SpectralImage& image, bool multi,
       fb.insert(name, Imf::Slice(Imf::HALF, const_cast<char*>(base + sizeof(half) * j), x_stride, y_stride));
     }
     header.insert(kAttrBasisPrefix + light.name, Imf::FloatVectorAttribute(Imf::FloatVector(c.basis.begin(), c.basis.end())));
-    sum += hash_floats(rounded.data(), rounded.size(), kFnvBasisCoefficients);
-    sum += hash_floats(c.basis.data(), c.basis.size(), kFnvBasisVectors);
+    sum += hash_float_bits(rounded.data(), rounded.size(), kFnvBasisCoefficients);
+    sum += hash_float_bits(c.basis.data(), c.basis.size(), kFnvBasisVectors);
     nlohmann::json errors = nlohmann::json::array();
     for (const BasisError& e : c.errors) errors.push_back({{"light", e.light}, {"percentile", e.percentile}, {"max", e.max}});
     lights.push_back({{"name", light.name}, {"k", c.k}, {"deltaE00", errors}});
@@ -250,8 +237,8 @@ std::uint64_t coefficients_checksum(const SpectralImage& image) {
   std::uint64_t sum = 0;
   for (const TransportLayer& light : image.lights) {
     if (light.coefficients.k == 0) continue;
-    sum += hash_floats(light.coefficients.values.data(), light.coefficients.values.size(), kFnvBasisCoefficients);
-    sum += hash_floats(light.coefficients.basis.data(), light.coefficients.basis.size(), kFnvBasisVectors);
+    sum += hash_float_bits(light.coefficients.values.data(), light.coefficients.values.size(), kFnvBasisCoefficients);
+    sum += hash_float_bits(light.coefficients.basis.data(), light.coefficients.basis.size(), kFnvBasisVectors);
   }
   return sum;
 }

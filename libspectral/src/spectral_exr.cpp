@@ -54,6 +54,7 @@
 #include "prizma/spectral/tool_main.h"
 #include "bispectral_exr.h"
 #include "coefficients_exr.h"
+#include "float_hash.h"
 #include "text_util.h"
 
 namespace prizma::spectral {
@@ -220,22 +221,9 @@ struct OutLayer {
 // values as a reader gets them (float32 bit patterns, one 32-bit word per step), with different
 // offset bases for transport and variance; the per-layer hashes are summed modulo 2⁶⁴ so that the
 // order of the layers does not matter. It covers the pixels, not the header.
-constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
 constexpr std::uint64_t kFnvBasisLight = 0xcbf29ce484222325ULL;
 constexpr std::uint64_t kFnvBasisVariance = 0x84222325cbf29ce4ULL;
 constexpr std::uint64_t kFnvBasisSum = 0xe4842223cbf2925cULL;  // the top-level T layer (v2)
-
-template <typename Value>
-std::uint64_t layer_hash(const Value* v, std::size_t n, std::uint64_t basis) {
-  std::uint64_t h = basis;
-  for (std::size_t k = 0; k < n; ++k) {
-    const float f = static_cast<float>(v[k]);
-    std::uint32_t bits;
-    std::memcpy(&bits, &f, sizeof bits);
-    h = (h ^ bits) * kFnvPrime;
-  }
-  return h;
-}
 
 // OpenEXR's output stream over write_atomically's checked temporary: a failed write throws (OpenEXR
 // is C++), and AtomicOutput keeps the system's reason for the message.
@@ -265,8 +253,8 @@ std::uint64_t light_layers_hash(const SpectralImage& image) {
   std::uint64_t sum = 0;
   for (const auto& light : image.lights) {
     if (light.data.empty()) continue;  // a compact file: coefficients only
-    sum += layer_hash(light.data.data(), light.data.size(), kFnvBasisLight);
-    if (!light.variance.empty()) sum += layer_hash(light.variance.data(), light.variance.size(), kFnvBasisVariance);
+    sum += detail::hash_float_bits(light.data.data(), light.data.size(), kFnvBasisLight);
+    if (!light.variance.empty()) sum += detail::hash_float_bits(light.variance.data(), light.variance.size(), kFnvBasisVariance);
   }
   return sum;
 }
@@ -362,7 +350,7 @@ std::string spectral_pixel_checksum(const SpectralImage& image) {
   std::uint64_t sum = light_layers_hash(image);
   if (image.lights.size() >= 2) {
     const std::vector<float> total = sum_of_lights(image);
-    sum += layer_hash(total.data(), total.size(), kFnvBasisSum);
+    sum += detail::hash_float_bits(total.data(), total.size(), kFnvBasisSum);
   }
   sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
   sum += detail::coefficients_checksum(image);  // 0 without spectral-basis coefficients
@@ -517,7 +505,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
       const std::uint64_t basis = layer.kind == LayerKind::Light   ? kFnvBasisLight
                                   : layer.kind == LayerKind::Sum ? kFnvBasisSum
                                                                  : kFnvBasisVariance;
-      checksum += half_out ? layer_hash(hv, expected, basis) : layer_hash(layer.data->data(), expected, basis);
+      checksum += half_out ? detail::hash_float_bits(hv, expected, basis) : detail::hash_float_bits(layer.data->data(), expected, basis);
     }
   }
 
@@ -851,7 +839,7 @@ void verify_checksum(const std::string& p, const Imf::Header& header, const std:
   std::string expected;
   if (stored.rfind(kChecksumScheme, 0) == 0) {
     std::uint64_t sum = light_layers_hash(image);
-    if (top != nullptr) sum += layer_hash(top->data(), top->size(), kFnvBasisSum);
+    if (top != nullptr) sum += detail::hash_float_bits(top->data(), top->size(), kFnvBasisSum);
     sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
     sum += detail::coefficients_checksum(image);  // 0 without spectral-basis coefficients
     expected = checksum_string(sum);
