@@ -108,7 +108,7 @@ void BM_ExactVsCompressed4K(benchmark::State& state) {
   state.counters["compressed_relight_ms"] = 1e3 * comp_relight / n;
   state.counters["encode_ms"] = 1e3 * (exact_encode + comp_encode) / (2 * n);
   state.counters["ratio"] = (exact_relight + exact_encode) / (comp_relight + comp_encode);
-  // The fused frame (relight_compressed_to_display8: one pass, display matrix folded in, small table,
+  // The fused frame (relight_compressed_to_display8: one pass, display matrix folded in, step table,
   // Highway SIMD): its ms, exact frame ÷ fused and unfused compressed frame ÷ fused.
   state.counters["fused_ms"] = 1e3 * fused / n;
   state.counters["fused_cpu_ms"] = 1e3 * fused_cpu / n;  // CPU time of all threads: less sensitive to load
@@ -119,7 +119,8 @@ void BM_ExactVsCompressed4K(benchmark::State& state) {
   for (const auto& layer : comp.lights) coefficient_bytes += static_cast<double>(layer.coefficients.size() * sizeof(layer.coefficients[0]));
   state.counters["coefficients_MB"] = coefficient_bytes / 1e6;
   state.counters["fused_GBps"] = (coefficient_bytes + static_cast<double>(rgb_fused.size())) * n / fused / 1e9;
-  state.counters["small_lut"] = encoder.small_lut(0).empty() ? 0 : static_cast<double>(encoder.small_lut(0).size());
+  state.counters["step_table"] = static_cast<double>(encoder.step_table().entries[0].size());  // 0: none (unfused)
+  state.counters["step_shift"] = encoder.step_table().shift;
   state.counters["load_start"] = load_start;
   state.counters["load_end"] = bench::load_average();
   state.counters["baked"] = encoder.baked() ? 1 : 0;

@@ -302,65 +302,75 @@ DisplayEncoder8::DisplayEncoder8(const spectral::DisplayTransform& display) : m_
       break;
     }
   }
-  if (m_baked) build_small_lut();
+  if (m_baked) build_step_table();
 }
 
-// The small table: buckets of equal width over [0, top], narrower than the closest two code steps
-// of any channel (so that at most one step lies in a bucket and one comparison corrects the guess),
-// at most 65536 entries; each bucket holds the code of a value just below its lower edge. Checked
-// against the thresholds (both sides of every step, and 4096 spread values) before it is used.
-void DisplayEncoder8::build_small_lut() {
-  float top = 0.0f, gap = std::numeric_limits<float>::infinity();
+// The step table: buckets of 2^shift consecutive float bit patterns (a fixed fraction of an octave,
+// so narrow where the curve's steps are close, wide where they are far apart) between just below the
+// smallest positive threshold and the largest finite one, for the widest buckets (shift from 16 down
+// to 12) that hold at most one threshold each and fit in 16384 entries. Bit patterns of non-negative
+// floats are ordered as their values, so a compare of the low bits is the exact v ≥ threshold test.
+// Checked against the thresholds (both sides of every step, and 4096 spread values) before it is used.
+void DisplayEncoder8::build_step_table() {
+  float first = std::numeric_limits<float>::infinity(), last = 0.0f;
   for (const auto& thr : m_thresholds) {
-    float prev = 0.0f;
-    for (std::size_t j = 1; j < 256; ++j) {
-      if (!std::isfinite(thr[j])) break;
-      if (thr[j] > 0.0f) {
-        gap = std::min(gap, thr[j] - prev);
-        prev = thr[j];
-      }
-      top = std::max(top, thr[j]);
+    for (std::size_t j = 1; j < 256 && std::isfinite(thr[j]); ++j) {
+      if (thr[j] > 0.0f) first = std::min(first, thr[j]);
+      last = std::max(last, thr[j]);
     }
   }
-  if (!(top > 0.0f) || !(gap > 0.0f)) return;
-  top *= 1.001f;
-  const double needed = 1.05 * static_cast<double>(top) / static_cast<double>(gap);
-  if (needed > 65536.0) return;
-  std::size_t size = 64;
-  while (static_cast<double>(size) < needed) size *= 2;
-  const float scale = static_cast<float>(static_cast<double>(size) / static_cast<double>(top));
-  auto guess_code = [&](std::size_t c, float v) {
+  if (!std::isfinite(first) || !(last > 0.0f)) return;
+  auto code_at = [&](std::size_t c, float v) {  // the number of thresholds ≤ v: the code of v ≥ 0
     const auto& thr = m_thresholds[c];
-    return static_cast<std::uint8_t>(std::upper_bound(thr.begin() + 1, thr.begin() + 256, v) - (thr.begin() + 1));
+    return static_cast<std::uint32_t>(std::upper_bound(thr.begin() + 1, thr.begin() + 256, v) - (thr.begin() + 1));
   };
-  for (std::size_t c = 0; c < 3; ++c) {
-    m_small[c].resize(size);
-    for (std::size_t b = 0; b < size; ++b) {
-      const float v = std::max(0.0f, static_cast<float>((static_cast<double>(b) - 0.01) / static_cast<double>(scale)));
-      m_small[c][b] = guess_code(c, v);
-    }
-  }
-  m_small_scale = scale;
-  auto small_code = [&](std::size_t c, float v) {
-    const float x = std::min(std::max(v, 0.0f) * scale, static_cast<float>(size - 1));
-    std::uint32_t code = static_cast<std::uint32_t>(m_small[c][static_cast<std::size_t>(x)]);
-    if (std::max(v, 0.0f) >= m_thresholds[c][code + 1]) ++code;
-    return code;
-  };
-  for (std::size_t c = 0; c < 3; ++c) {
-    std::vector<float> probes = {0.0f, -1.0f, top, 2.0f * top, 1e30f};
-    for (std::size_t j = 1; j < 256 && std::isfinite(m_thresholds[c][j]); ++j) {
-      probes.push_back(m_thresholds[c][j]);
-      probes.push_back(std::nextafter(m_thresholds[c][j], -1.0f));
-    }
-    for (int i = 0; i < 4096; ++i) probes.push_back(top * static_cast<float>(i) / 4000.0f);
-    for (const float v : probes) {
-      if (small_code(c, v) != guess_code(c, std::max(v, 0.0f))) {
-        for (auto& t : m_small) t.clear();
-        m_small_scale = 0.0f;
-        return;
+  const auto first_bits = std::bit_cast<std::int32_t>(first), hi_bits = std::bit_cast<std::int32_t>(last);
+  for (int shift = 16; shift >= 12; --shift) {
+    const std::int32_t lo_bits = ((first_bits - 1) >> shift) << shift;  // below every positive threshold
+    const std::int32_t base = lo_bits >> shift;
+    const std::size_t size = static_cast<std::size_t>((hi_bits >> shift) - base + 1);
+    if (size > 16384) return;
+    StepTable t;
+    t.shift = shift;
+    t.base = base;
+    t.lo_bits = lo_bits;
+    t.hi_bits = hi_bits;
+    const std::uint32_t none = 1u << shift;
+    bool fits = true;
+    for (std::size_t c = 0; c < 3 && fits; ++c) {
+      t.entries[c].resize(size);
+      for (std::size_t i = 0; i < size && fits; ++i) {
+        const std::int32_t start = (base + static_cast<std::int32_t>(i)) << shift;
+        const std::int32_t end = start + static_cast<std::int32_t>(none) - 1;  // the bucket's last bit pattern
+        const std::uint32_t code = code_at(c, std::bit_cast<float>(start));
+        const std::uint32_t steps = code_at(c, std::bit_cast<float>(end)) - code;
+        if (steps > 1) fits = false;
+        const std::uint32_t step = steps == 0 ? none
+                                              : static_cast<std::uint32_t>(
+                                                    std::bit_cast<std::int32_t>(m_thresholds[c][code + 1]) - start);
+        t.entries[c][i] = code | (step << 8);
       }
     }
+    if (!fits) continue;
+    auto table_code = [&](std::size_t c, float v) {
+      const std::int32_t b = std::clamp(std::bit_cast<std::int32_t>(std::max(v, 0.0f)), t.lo_bits, t.hi_bits);
+      const std::uint32_t e = t.entries[c][static_cast<std::size_t>((b >> t.shift) - t.base)];
+      const auto low = static_cast<std::uint32_t>(b & static_cast<std::int32_t>(none - 1));
+      return (e & 255u) + (low >= (e >> 8) ? 1u : 0u);
+    };
+    for (std::size_t c = 0; c < 3; ++c) {
+      std::vector<float> probes = {0.0f, -1.0f, -0.0f, first, last, 2.0f * last, 1e30f,
+                                   std::numeric_limits<float>::infinity()};
+      for (std::size_t j = 1; j < 256 && std::isfinite(m_thresholds[c][j]); ++j) {
+        probes.push_back(m_thresholds[c][j]);
+        probes.push_back(std::nextafter(m_thresholds[c][j], -1.0f));
+      }
+      for (int i = 0; i < 4096; ++i) probes.push_back(last * static_cast<float>(i) / 4000.0f);
+      for (const float v : probes)
+        if (table_code(c, v) != code_at(c, std::max(v, 0.0f))) return;
+    }
+    m_steps = std::move(t);
+    return;
   }
 }
 
@@ -494,7 +504,7 @@ CompressedTransport compress_spectral_exr(const std::filesystem::path& input, co
 void relight_compressed_to_display8(const CompressedTransport& transport, const RelightMatrix& matrix,
                                     const DisplayEncoder8& encoder, std::uint8_t* rgb_out) {
   const std::size_t pixels = transport.pixel_count();
-  if (!encoder.baked() || encoder.small_lut(0).empty() || transport.lights.size() > detail::kMaxFusedLayers) {
+  if (!encoder.baked() || encoder.step_table().empty() || transport.lights.size() > detail::kMaxFusedLayers) {
     std::vector<float> xyz(3 * pixels);
     relight_compressed_into(transport, matrix, xyz.data());
     encoder.encode(xyz.data(), pixels, rgb_out);
@@ -506,13 +516,13 @@ void relight_compressed_to_display8(const CompressedTransport& transport, const 
     if (weights[t].empty()) continue;
     terms.push_back({weights[t].data(), transport.lights[t].coefficients.data(), transport.lights[t].k});
   }
+  const DisplayEncoder8::StepTable& steps = encoder.step_table();
   detail::SimdEncoder enc;
-  for (int c = 0; c < 3; ++c) {
-    enc.lut[c] = encoder.small_lut(c).data();
-    enc.thresholds[c] = encoder.thresholds(c);
-  }
-  enc.lut_size = static_cast<int>(encoder.small_lut(0).size());
-  enc.lut_scale = encoder.small_lut_scale();
+  for (int c = 0; c < 3; ++c) enc.entries[c] = steps.entries[static_cast<std::size_t>(c)].data();
+  enc.shift = steps.shift;
+  enc.base = steps.base;
+  enc.lo_bits = steps.lo_bits;
+  enc.hi_bits = steps.hi_bits;
   const int width = transport.width;
   const std::size_t scratch_floats = detail::compressed_row_scratch(terms.data(), static_cast<int>(terms.size()), width);
   tbb::parallel_for(tbb::blocked_range<int>(0, transport.height), [&](const tbb::blocked_range<int>& rows) {

@@ -15,13 +15,13 @@ struct SimdCoeffLayer {
   int k;
 };
 
-// DisplayEncoder8's small table per channel: code(v) = lut[min(v·scale, size−1)] (+1 when v ≥
-// thresholds[code + 1]), v clamped below at 0; thresholds[256] = +∞.
+// DisplayEncoder8's step table (DisplayEncoder8::StepTable): for the bits b of linear v (v < 0 and NaN
+// as 0) clamped to [lo_bits, hi_bits], e = entries[c][(b >> shift) − base] and
+// code = (e & 255) + ((b & (2^shift − 1)) ≥ (e >> 8)).
 struct SimdEncoder {
-  const std::int32_t* lut[3] = {nullptr, nullptr, nullptr};
-  const float* thresholds[3] = {nullptr, nullptr, nullptr};
-  int lut_size = 0;
-  float lut_scale = 0.0f;
+  const std::uint32_t* entries[3] = {nullptr, nullptr, nullptr};
+  int shift = 0;
+  std::int32_t base = 0, lo_bits = 0, hi_bits = 0;
 };
 
 // The most float lanes of any target (AVX-512: 16), and the most lights one fused row takes.

@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -220,6 +221,47 @@ TEST(DisplayEncoder8, AColourSpaceConversionIsAMatrixAndBakesToo) {
   }
 }
 
+// The step table's code (one entry read, one compare of the low bits) against the thresholds
+// themselves: exactly the number of thresholds ≤ v, on both sides of every step, over 40 octaves
+// (both clamps) and for negatives, for sRGB and for a display whose curve is only a clamp.
+TEST(DisplayEncoder8, StepTableCodeIsExactlyTheThresholdCount) {
+  spectral::DisplayOptions linear;
+  linear.colour_space = "Linear sRGB";
+  for (const auto& options : {spectral::DisplayOptions{}, linear}) {
+    const spectral::DisplayTransform display(options);
+    const DisplayEncoder8 encoder(display);
+    ASSERT_TRUE(encoder.baked());
+    const DisplayEncoder8::StepTable& t = encoder.step_table();
+    ASSERT_FALSE(t.empty());
+    EXPECT_LE(t.entries[0].size(), 16384u);
+    auto table_code = [&](int c, float v) {
+      const std::int32_t b = std::clamp(std::bit_cast<std::int32_t>(std::max(v, 0.0f)), t.lo_bits, t.hi_bits);
+      const std::uint32_t e = t.entries[static_cast<std::size_t>(c)][static_cast<std::size_t>((b >> t.shift) - t.base)];
+      return int(e & 255u) + ((b & ((1 << t.shift) - 1)) >= std::int32_t(e >> 8) ? 1 : 0);
+    };
+    for (int c = 0; c < 3; ++c) {
+      const float* thr = encoder.thresholds(c);
+      auto count = [&](float v) { return int(std::upper_bound(thr + 1, thr + 256, std::max(v, 0.0f)) - (thr + 1)); };
+      int steps = 0;
+      for (int j = 1; j < 256; ++j) {
+        if (!std::isfinite(thr[j]) || thr[j] <= 0.0f) continue;
+        ++steps;
+        EXPECT_EQ(table_code(c, thr[j]), count(thr[j])) << "at threshold " << j << " of channel " << c;
+        const float below = std::nextafter(thr[j], 0.0f);
+        EXPECT_EQ(table_code(c, below), count(below)) << "below threshold " << j << " of channel " << c;
+      }
+      EXPECT_GT(steps, 200) << "a curve with steps";
+      std::uint64_t state = 12345;
+      for (int i = 0; i < 200000; ++i) {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        const float v = std::ldexp(static_cast<float>(state >> 40) / 16777216.0f, static_cast<int>(state % 41) - 30);
+        ASSERT_EQ(table_code(c, v), count(v)) << v;
+        ASSERT_EQ(table_code(c, -v), count(0.0f)) << -v;
+      }
+    }
+  }
+}
+
 TEST(LightWeights, SkipsLightsThatAreOffAndChecksTheShape) {
   const auto bins = spectral::BinLayout::linear(400.0, 700.0, 8);
   const RelightMatrix m(bins, {parse_light_spec("off"), parse_light_spec("D65")}, {});
@@ -240,7 +282,7 @@ TEST(DisplayEncoder8, FusedFrameEqualsRelightThenEncode) {
   const spectral::DisplayTransform display(spectral::DisplayOptions{});
   const DisplayEncoder8 encoder(display);
   ASSERT_TRUE(encoder.baked());
-  ASSERT_FALSE(encoder.small_lut(0).empty()) << "the sRGB curve gets the small table";
+  ASSERT_FALSE(encoder.step_table().empty()) << "the sRGB curve gets the step table";
   for (const auto& lights : {two_lights(), std::vector<LightSpec>{parse_light_spec("off"), parse_light_spec("F11*3")}}) {
     RelightOptions o;
     o.exposure_ev = 0.7;
@@ -289,7 +331,7 @@ TEST(DisplayEncoder8, FusedFrameOnEverySimdTargetAndEveryK) {
   const CompressedTransport full = compress_transport(img, all);
   const spectral::DisplayTransform display(spectral::DisplayOptions{});
   const DisplayEncoder8 encoder(display);
-  ASSERT_FALSE(encoder.small_lut(0).empty());
+  ASSERT_FALSE(encoder.step_table().empty());
   const RelightMatrix m(img.bins, {parse_light_spec("D65*0.8"), parse_light_spec("F11")}, {});
   const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
   ASSERT_FALSE(targets.empty());

@@ -90,11 +90,11 @@ XyzImage relight_compressed(const CompressedTransport& transport, const RelightM
 class DisplayEncoder8;
 
 // One frame from coefficients straight to 8-bit display RGB (3·pixels bytes, interleaved): the
-// display matrix folded into the 3×k weights (A·M_l·B_l), each row relit into a row of linear RGB and
-// encoded through the encoder's small table while it is in cache (TBB over rows, Highway SIMD over
-// pixels). The codes equal encoder.encode(relight_compressed_into(...)) within one (float rounding
-// of the folded matrix), and do not depend on the thread count. Needs a baked encoder with a small
-// table; otherwise it relights to XYZ and calls encode() (same codes, slower).
+// display matrix folded into the 3×k weights (A·M_l·B_l), each block of pixels relit to linear RGB in
+// registers and encoded through the encoder's step table (TBB over rows, Highway SIMD over pixels).
+// The codes equal encoder.encode(relight_compressed_into(...)) within one (float rounding of the
+// folded matrix), and do not depend on the thread count. Needs a baked encoder with a step table;
+// otherwise it relights to XYZ and calls encode() (same codes, slower).
 void relight_compressed_to_display8(const CompressedTransport& transport, const RelightMatrix& matrix,
                                     const DisplayEncoder8& encoder, std::uint8_t* rgb_out);
 
@@ -102,7 +102,8 @@ void relight_compressed_to_display8(const CompressedTransport& transport, const 
 // clamp to [0, 1], round to 255ths), computed fast when the transform is a matrix followed by a
 // per-channel curve (DisplayTransform::split_matrix_curve): the curve is baked into the 255 exact
 // linear thresholds between codes per channel, found by bisection on the curve itself, with a
-// 32768-entry table per channel indexed by a float's top 16 bits for a first guess. The baked form
+// 32768-entry table per channel indexed by a float's top 16 bits for a first guess (and, for the
+// fused frame, the step table below: one read per code). The baked form
 // is checked against the full transform on 4096 colours at construction; where the split does not
 // exist or the check fails, encode() runs the OCIO transform itself.
 class DisplayEncoder8 {
@@ -111,10 +112,21 @@ class DisplayEncoder8 {
   bool baked() const { return m_baked; }
   // Baked: the display matrix (XYZ → linear display RGB) and the curve as code thresholds.
   const Eigen::Matrix3f& matrix() const { return m_matrix; }
-  // The small table (baked curves whose code steps are not too close): code of linear v ≥ 0 is
-  // lut[min(v·lut_scale, size−1)], plus one when v ≥ threshold(code + 1). Empty when not available.
-  const std::vector<std::int32_t>& small_lut(int channel) const { return m_small[static_cast<std::size_t>(channel)]; }
-  float small_lut_scale() const { return m_small_scale; }
+  // The step table (baked curves with at most one code step in any bucket of 2^shift float bit
+  // patterns; empty otherwise): one 32-bit entry per bucket and channel holding both the code of the
+  // bucket's first value and where in the bucket the next step lies, so that a code is one table read
+  // and one integer compare, exact (no float rounding). For a linear value v, its bits b (as int32)
+  // clamped to [lo_bits, hi_bits] and i = (b >> shift) − base:
+  //   code = (entries[c][i] & 255) + ((b & (2^shift − 1)) ≥ (entries[c][i] >> 8)),
+  // where entries[c][i] >> 8 is 2^shift when no step lies inside the bucket. Values below lo_bits
+  // (negatives included) take the code of 0; values above hi_bits the code of the largest threshold.
+  struct StepTable {
+    std::array<std::vector<std::uint32_t>, 3> entries;
+    int shift = 0;
+    std::int32_t base = 0, lo_bits = 0, hi_bits = 0;
+    bool empty() const { return entries[0].empty(); }
+  };
+  const StepTable& step_table() const { return m_steps; }
   // thresholds(c)[j]: the smallest linear value with code ≥ j (j = 1..255), [256] = +∞.
   const float* thresholds(int channel) const { return m_thresholds[static_cast<std::size_t>(channel)].data(); }
   // xyz: 3·pixels floats, interleaved; rgb: 3·pixels bytes. Non-finite values count as 0.
@@ -122,7 +134,7 @@ class DisplayEncoder8 {
 
  private:
   void encode_chunk(const float* xyz, std::size_t pixels, std::uint8_t* rgb) const;
-  void build_small_lut();
+  void build_step_table();
   const spectral::DisplayTransform* m_display;
   bool m_baked = false;
   Eigen::Matrix3f m_matrix = Eigen::Matrix3f::Identity();
@@ -130,8 +142,7 @@ class DisplayEncoder8 {
   // [256] = +∞).
   std::array<std::array<float, 257>, 3> m_thresholds{};
   std::array<std::vector<std::uint8_t>, 3> m_guess;  // code of the smallest value of each 16-bit bucket
-  std::array<std::vector<std::int32_t>, 3> m_small;  // the small table (small_lut)
-  float m_small_scale = 0.0f;
+  StepTable m_steps;
 };
 
 }  // namespace prizma::relight
