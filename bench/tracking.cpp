@@ -68,6 +68,17 @@ const pr::Scene& dense_scene() {
   static const pr::Scene s = box_scene(64, [](double, double, double) { return true; }, chromatic_material(10.0));
   return s;
 }
+// The dense box with the scheme forced to `max` (an absorption event per collision, as a
+// one-wavelength path has): where `auto` takes `implicit` (absorption left in the weight, longer
+// paths of lower variance), the per-path cost ratio compares paths of different lengths.
+const pr::Scene& dense_max_scene() {
+  static const pr::Scene s = [] {
+    pr::Scene sc = dense_scene();
+    sc.settings.event_probabilities = pr::EventProbabilities::Max;
+    return sc;
+  }();
+  return s;
+}
 // A sphere of radius 0.25 in [−1, 1]³: 0.8 % of the box holds material.
 const pr::Scene& sparse_scene() {
   static const pr::Scene s = box_scene(
@@ -271,6 +282,8 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark("AllBinsVsSingle/cube_16bins", [](benchmark::State& s) { bin_cost(s, cube_scene(), 16); })
       ->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("AllBinsVsSingle/dense_16bins", [](benchmark::State& s) { bin_cost(s, dense_scene(), 16); })
+      ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("AllBinsVsSingle/dense_16bins_max", [](benchmark::State& s) { bin_cost(s, dense_max_scene(), 16); })
       ->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("Threads/cube", [](benchmark::State& s) { threads(s, cube_scene()); })
       ->Unit(benchmark::kMillisecond)
