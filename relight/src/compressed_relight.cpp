@@ -359,8 +359,7 @@ void DisplayEncoder8::build_step_table() {
       return (e & 255u) + (low >= (e >> 8) ? 1u : 0u);
     };
     for (std::size_t c = 0; c < 3; ++c) {
-      std::vector<float> probes = {0.0f, -1.0f, -0.0f, first, last, 2.0f * last, 1e30f,
-                                   std::numeric_limits<float>::infinity()};
+      std::vector<float> probes = {0.0f, -1.0f, -0.0f, first, last, 2.0f * last, 1e30f};
       for (std::size_t j = 1; j < 256 && std::isfinite(m_thresholds[c][j]); ++j) {
         probes.push_back(m_thresholds[c][j]);
         probes.push_back(std::nextafter(m_thresholds[c][j], -1.0f));
