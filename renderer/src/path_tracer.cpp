@@ -452,8 +452,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
     else
       tau = sigma_t * run_depth;
     any_control = true;
-    tau_min = tau[0];
-    for (int i = 1; i < n; ++i) tau_min = std::min(tau_min, tau[i]);
+    tau_min = partial::min_from_infinity(tau, n);
     run_depth = 0.0f;
   };
   float t_res_max = 1.0f;  // the largest lane of T (the residual product)
@@ -483,9 +482,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
       flush();
       run_material = m;
       if (!s.cache.holds(m)) evaluate_material(m, s);
-      const float* st = s.cache.sigma_t.data() + static_cast<std::size_t>(m) * n;
-      run_sigma_min = st[0];
-      for (int i = 1; i < n; ++i) run_sigma_min = std::min(run_sigma_min, st[i]);
+      run_sigma_min = partial::min_from_infinity(s.cache.sigma_t.data() + static_cast<std::size_t>(m) * n, n);
     }
     run_depth += control->density * static_cast<float>(seg.t1 - seg.t0);
     return true;

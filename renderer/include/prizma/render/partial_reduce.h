@@ -25,6 +25,23 @@ float max_from_zero(const X& x, int n) {
   return m;
 }
 
+// min(+∞, the least x[i]): for n ≥ 1 and no NaN, the value of the sequential loop m = std::min(m,
+// x[i]) from m = x[0], whatever the order (its bits too, but for which of +0 and −0 a tie of zeros
+// keeps; they compare equal).
+template <class X>
+float min_from_infinity(const X& x, int n) {
+  constexpr float kInf = __builtin_huge_valf();
+  float part[kWidth] = {kInf, kInf, kInf, kInf, kInf, kInf, kInf, kInf};
+  static_assert(kWidth == 8, "one initialiser per partial");
+  int i = 0;
+  for (; i + kWidth <= n; i += kWidth)
+    for (int k = 0; k < kWidth; ++k) part[k] = std::min(part[k], x[i + k]);
+  for (int k = 0; i < n; ++i, ++k) part[k] = std::min(part[k], x[i]);
+  float m = kInf;
+  for (int k = 0; k < kWidth; ++k) m = std::min(m, part[k]);
+  return m;
+}
+
 // Σ x[i] in the partials' order (not lane order: ConstLanes::sum and sum_over keep that).
 template <class X>
 float sum(const X& x, int n) {
