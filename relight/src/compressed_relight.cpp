@@ -305,6 +305,13 @@ DisplayEncoder8::DisplayEncoder8(const spectral::DisplayTransform& display) : m_
   if (m_baked) build_step_table();
 }
 
+std::uint32_t DisplayEncoder8::StepTable::code(int channel, float v) const {
+  const std::int32_t b = std::clamp(std::bit_cast<std::int32_t>(std::max(v, 0.0f)), lo_bits, hi_bits);
+  const std::uint32_t e = entries[static_cast<std::size_t>(channel)][static_cast<std::size_t>((b >> shift) - base)];
+  const auto low = static_cast<std::uint32_t>(b & ((std::int32_t{1} << shift) - 1));
+  return (e & 255u) + (low >= (e >> 8) ? 1u : 0u);
+}
+
 // The step table: buckets of 2^shift consecutive float bit patterns (a fixed fraction of an octave,
 // so narrow where the curve's steps are close, wide where they are far apart) between just below the
 // smallest positive threshold and the largest finite one, for the widest buckets (shift from 16 down
@@ -352,12 +359,6 @@ void DisplayEncoder8::build_step_table() {
       }
     }
     if (!fits) continue;
-    auto table_code = [&](std::size_t c, float v) {
-      const std::int32_t b = std::clamp(std::bit_cast<std::int32_t>(std::max(v, 0.0f)), t.lo_bits, t.hi_bits);
-      const std::uint32_t e = t.entries[c][static_cast<std::size_t>((b >> t.shift) - t.base)];
-      const auto low = static_cast<std::uint32_t>(b & static_cast<std::int32_t>(none - 1));
-      return (e & 255u) + (low >= (e >> 8) ? 1u : 0u);
-    };
     for (std::size_t c = 0; c < 3; ++c) {
       std::vector<float> probes = {0.0f, -1.0f, -0.0f, first, last, 2.0f * last, 1e30f};
       for (std::size_t j = 1; j < 256 && std::isfinite(m_thresholds[c][j]); ++j) {
@@ -366,7 +367,7 @@ void DisplayEncoder8::build_step_table() {
       }
       for (int i = 0; i < 4096; ++i) probes.push_back(last * static_cast<float>(i) / 4000.0f);
       for (const float v : probes)
-        if (table_code(c, v) != code_at(c, std::max(v, 0.0f))) return;
+        if (t.code(static_cast<int>(c), v) != code_at(c, std::max(v, 0.0f))) return;
     }
     m_steps = std::move(t);
     return;

@@ -163,7 +163,6 @@ void CompressedRowToDisplay8(const SimdCoeffLayer* layers, int layer_count, std:
   }
 }
 
-
 }  // namespace prizma::relight::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 

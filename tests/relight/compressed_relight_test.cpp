@@ -8,7 +8,6 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -234,11 +233,7 @@ TEST(DisplayEncoder8, StepTableCodeIsExactlyTheThresholdCount) {
     const DisplayEncoder8::StepTable& t = encoder.step_table();
     ASSERT_FALSE(t.empty());
     EXPECT_LE(t.entries[0].size(), 16384u);
-    auto table_code = [&](int c, float v) {
-      const std::int32_t b = std::clamp(std::bit_cast<std::int32_t>(std::max(v, 0.0f)), t.lo_bits, t.hi_bits);
-      const std::uint32_t e = t.entries[static_cast<std::size_t>(c)][static_cast<std::size_t>((b >> t.shift) - t.base)];
-      return int(e & 255u) + ((b & ((1 << t.shift) - 1)) >= std::int32_t(e >> 8) ? 1 : 0);
-    };
+    auto table_code = [&](int c, float v) { return static_cast<int>(t.code(c, v)); };
     for (int c = 0; c < 3; ++c) {
       const float* thr = encoder.thresholds(c);
       auto count = [&](float v) { return int(std::upper_bound(thr + 1, thr + 256, std::max(v, 0.0f)) - (thr + 1)); };

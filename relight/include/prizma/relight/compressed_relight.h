@@ -125,6 +125,9 @@ class DisplayEncoder8 {
     int shift = 0;
     std::int32_t base = 0, lo_bits = 0, hi_bits = 0;
     bool empty() const { return entries[0].empty(); }
+    // The code of linear v by the formula above, one value at a time (the fused frame's kernel is
+    // its SIMD form); the table must not be empty.
+    std::uint32_t code(int channel, float v) const;
   };
   const StepTable& step_table() const { return m_steps; }
   // thresholds(c)[j]: the smallest linear value with code ≥ j (j = 1..255), [256] = +∞.
