@@ -241,6 +241,7 @@ int run(const CliOptions& o) {
     so.bind = o.bind;
     so.port = o.port;
     so.save_dir = o.save_dir;
+    if (o.verbose) so.log = &std::cerr;
     relight::RelightServer server(session, so);
     if (!relight::is_loopback_address(o.bind) && !o.quiet) {
       std::cerr << "prizma-relight: warning: --bind " << o.bind
