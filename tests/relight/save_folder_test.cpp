@@ -1,7 +1,6 @@
 // The live page's Save (save_folder.h): plain names in one folder, never the served file (nor a hard
 // link to it), never through a symbolic link, at most SaveFolder::kMaxCreatedFiles new files.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -9,6 +8,7 @@
 
 #include "prizma/relight/save_folder.h"
 #include "prizma/spectral/error.h"
+#include "relight/relight_test_util.h"
 
 namespace prizma::relight {
 namespace {
@@ -18,10 +18,8 @@ namespace fs = std::filesystem;
 class SaveFolderTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = fs::temp_directory_path() / ("prizma-save-folder-" + std::to_string(::getpid()) + "-" +
-                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    dir = test::scratch_dir(std::string("save-folder-") +
+                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     served = dir / "scene.exr";
     write_text(served, "served");
   }
