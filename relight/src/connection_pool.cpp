@@ -74,7 +74,8 @@ RequestProgress request_progress(std::string_view received, std::size_t max_body
     const std::size_t next = received.find("\r\n", pos + 2);
     const std::string_view line = received.substr(pos + 2, next - pos - 2);
     pos = next;
-    if (iequal_prefix(line, "transfer-encoding:")) return {true, header_bytes};
+    // A chunked body, or a client that waits for "100 Continue" before it sends its body.
+    if (iequal_prefix(line, "transfer-encoding:") || iequal_prefix(line, "expect:")) return {true, header_bytes};
     if (!iequal_prefix(line, "content-length:")) continue;
     std::string_view value = line.substr(15);
     while (!value.empty() && (value.front() == ' ' || value.front() == '\t')) value.remove_prefix(1);

@@ -38,6 +38,8 @@ TEST(RequestProgress, WaitsForADeclaredBodyUpToTheLimit) {
   EXPECT_TRUE(request_progress("POST / HTTP/1.1\r\nContent-Length: 5x\r\n\r\n", 100).complete);
   EXPECT_TRUE(request_progress("POST / HTTP/1.1\r\nContent-Length: 99999999999999999999999\r\n\r\n", 100).complete);
   EXPECT_TRUE(request_progress("POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n", 100).complete);
+  // A client that sends its body only after "100 Continue" would wait for the pool, and it for the body.
+  EXPECT_TRUE(request_progress("POST / HTTP/1.1\r\nContent-Length: 5\r\nExpect: 100-continue\r\n\r\n", 100).complete);
 }
 
 TEST(RequestProgress, GivesUpWaitingForAnOverlongHeader) {

@@ -33,7 +33,7 @@ struct ConnectionLimits {
 // Whether the bytes received so far on a connection hold a whole request: `complete` when the header
 // has ended ("\r\n\r\n") and its Content-Length body (up to max_body_bytes) is there too, or when the
 // request is malformed or too long for waiting to help (a header past 16 KiB, a body past the limit,
-// a Transfer-Encoding: the worker refuses or bounds these). `header_bytes`: the header's length with
+// a Transfer-Encoding, an Expect: 100-continue: the worker answers, refuses or bounds these). `header_bytes`: the header's length with
 // its blank line when it has ended, else 0.
 struct RequestProgress {
   bool complete = false;
