@@ -6,6 +6,7 @@
 // Bispectral (fluorescent) files: each light has more texture layers after its bins, its per-pixel
 // re-radiation weights K for the current observer (fetched again when the observer changes), with
 // weights from the server (wr), so the shader adds the re-radiated light in the same sum.
+// The URL fragment's text (the run's secret, the state ⇄ the controls' values) is state.js's.
 'use strict';
 
 const canvas = document.getElementById('relit');
