@@ -65,6 +65,7 @@ struct CliOptions {
   std::string bind = "127.0.0.1";
   int port = 0;
   std::string save_dir = ".";
+  std::vector<std::string> serve_options_given;  // --bind, --port, --save-dir on the command line
   bool no_verify = false;
   bool exact = false;
 };
@@ -158,6 +159,7 @@ int run(const CliOptions& o) {
   }
   if (o.show_every && !o.interactive) throw InputError("--show-every", "only with -i/--interactive");
   if (o.serve && o.interactive) throw InputError("--serve", "not with -i/--interactive");
+  if (!o.serve && !o.serve_options_given.empty()) throw InputError(o.serve_options_given.front(), "only with --serve");
   if (!o.preview.empty() && !o.interactive) throw InputError("--preview", "only with -i/--interactive");
   // Cheap checks first: nothing is loaded when the output cannot be written.
   if (!o.output.empty()) relight::check_output_path(o.output, "--output");
@@ -241,6 +243,7 @@ int run(const CliOptions& o) {
     so.bind = o.bind;
     so.port = o.port;
     so.save_dir = o.save_dir;
+    if (o.verbose) so.log = &std::cerr;
     relight::RelightServer server(session, so);
     if (!relight::is_loopback_address(o.bind) && !o.quiet) {
       std::cerr << "prizma-relight: warning: --bind " << o.bind
@@ -364,6 +367,8 @@ int main(int argc, char** argv) {
              "coefficients (prizma-relight compress --help).");
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
   o.display_given = app.count("--display") > 0;
+  for (const char* name : {"--bind", "--port", "--save-dir"})
+    if (app.count(name) > 0) o.serve_options_given.emplace_back(name);
   std::optional<tbb::global_control> threads;
   if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
   return spectral::run_tool("prizma-relight", [&] { return run(o); });

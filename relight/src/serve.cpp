@@ -1,11 +1,15 @@
 // prizma-relight --serve: routes of the live page over cpp-httplib. Every route is a fixed path; the
-// page and its script come from the binary (serve_assets.h), data from the loaded session.
+// page and its script come from the binary (serve_assets.h), data from the loaded session. httplib
+// accepts connections and parses and answers requests; a ConnectionPool holds the connections
+// (connection_pool.h), PageAccess decides who may ask (page_access.h), SaveFolder where Save writes.
 #include "prizma/relight/serve.h"
 
 #include <Imath/half.h>
 #include <arpa/inet.h>
 #include <httplib.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -19,10 +23,11 @@
 #include <initializer_list>
 #include <map>
 #include <mutex>
-#include <regex>
 #include <system_error>
 #include <thread>
 
+#include "prizma/relight/connection_pool.h"
+#include "prizma/relight/save_folder.h"
 #include "prizma/relight/serve_state.h"
 #include "prizma/spectral/bispectral.h"
 #include "prizma/spectral/colour.h"
@@ -41,8 +46,8 @@ using spectral::InputError;
 
 // Transport texels pack four bins each (RGBA); bins past the last are zero.
 constexpr int kBinsPerTexel = 4;
-// A saved file's name: a plain name, no folder, no leading dot.
-const std::regex kSaveName("[A-Za-z0-9][A-Za-z0-9._-]{0,127}");
+// Request bodies: the API takes none (its parameters are in the URL).
+constexpr std::size_t kMaxBodyBytes = std::size_t{1} << 16;
 
 int texel_groups(int bins) { return (bins + kBinsPerTexel - 1) / kBinsPerTexel; }
 
@@ -66,27 +71,112 @@ int int_param(const httplib::Request& req, const std::string& key, int lo, int h
 
 json vec3(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
 
-}  // namespace
-
-bool is_loopback_address(const std::string& address) {
-  if (address == "localhost" || address == "::1") return true;
-  in_addr v4{};
-  if (::inet_pton(AF_INET, address.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
-  return false;
+// A socket's own (local) or peer address as text and port.
+void address_of(int fd, bool peer, std::string& ip, int& port) {
+  sockaddr_storage addr{};
+  socklen_t len = sizeof addr;
+  auto* sa = reinterpret_cast<sockaddr*>(&addr);
+  ip.clear();
+  port = 0;
+  if ((peer ? ::getpeername(fd, sa, &len) : ::getsockname(fd, sa, &len)) != 0) return;
+  char text[INET6_ADDRSTRLEN] = {};
+  if (addr.ss_family == AF_INET) {
+    const auto* a = reinterpret_cast<const sockaddr_in*>(&addr);
+    ::inet_ntop(AF_INET, &a->sin_addr, text, sizeof text);
+    port = ntohs(a->sin_port);
+  } else if (addr.ss_family == AF_INET6) {
+    const auto* a = reinterpret_cast<const sockaddr_in6*>(&addr);
+    ::inet_ntop(AF_INET6, &a->sin6_addr, text, sizeof text);
+    port = ntohs(a->sin6_port);
+  }
+  ip = text;
 }
+
+// One request of a pooled connection, as httplib reads and answers it.
+class ConnectionStream final : public httplib::Stream {
+ public:
+  explicit ConnectionStream(Connection& c) : m_c(c) {}
+  bool is_readable() const override { return m_c.readable(); }
+  bool is_writable() const override { return m_c.writable(); }
+  ssize_t read(char* ptr, std::size_t size) override { return m_c.read(ptr, size); }
+  ssize_t write(const char* ptr, std::size_t size) override { return m_c.write(ptr, size); }
+  using httplib::Stream::write;
+  void get_remote_ip_and_port(std::string& ip, int& port) const override { address_of(m_c.fd(), true, ip, port); }
+  void get_local_ip_and_port(std::string& ip, int& port) const override { address_of(m_c.fd(), false, ip, port); }
+  socket_t socket() const override { return m_c.fd(); }
+
+ private:
+  Connection& m_c;
+};
+
+// httplib's server with every accepted connection handed to a ConnectionPool instead of httplib's
+// thread pool (where each idle or slow connection held one of 8 threads until its timeout).
+// process_and_close_socket is httplib's (private, virtual) per-connection entry point.
+class PooledServer final : public httplib::Server {
+ public:
+  ConnectionPool* pool = nullptr;
+
+  // Reads and answers one request; false when the connection cannot carry another.
+  bool serve_request(httplib::Stream& stream, bool last) {
+    bool closed = false;
+    return process_request(stream, last, closed, nullptr) && !closed;
+  }
+
+ private:
+  bool process_and_close_socket(socket_t sock) override {
+    pool->admit(sock);
+    return true;
+  }
+};
+
+// The task queue httplib's listener gives each accepted socket to: passed straight on (to
+// process_and_close_socket, then ConnectionPool::admit, which never blocks); the pool is shut when
+// the listener stops.
+class PoolQueue final : public httplib::TaskQueue {
+ public:
+  explicit PoolQueue(ConnectionPool& pool) : m_pool(pool) {}
+  void enqueue(std::function<void()> fn) override { fn(); }
+  void shutdown() override { m_pool.shutdown(); }
+
+ private:
+  ConnectionPool& m_pool;
+};
+
+}  // namespace
 
 struct RelightServer::Impl {
   RelightSession& session;
   ServeOptions opts;
   RelightSettings base;  // the command line's settings: the page's starting state
-  httplib::Server server;
+  SaveFolder save_folder;
+  PageAccess access;
+  PooledServer server;
+  std::mutex log_mutex;
   int port = 0;
-  std::mutex mutex;  // guards session and caches (httplib runs handlers on a thread pool)
+  std::mutex mutex;  // guards session and caches (handlers run on the pool's workers)
   std::map<std::string, std::string> display_cache;
   // Bispectral files: K per observer, computed on first use (the page's re-radiation textures).
   std::map<spectral::Observer, ReradiationWeights> reradiation_cache;
+  // Last: destroyed first, so its workers have stopped before anything their handlers use goes.
+  std::unique_ptr<ConnectionPool> pool;
 
-  Impl(RelightSession& s, const ServeOptions& o) : session(s), opts(o), base(s.settings()) {}
+  Impl(RelightSession& s, const ServeOptions& o)
+      : session(s), opts(o), base(s.settings()), save_folder(o.save_dir, s.source()),
+        access(PageAccess::new_token(), o.bind, 0) {}
+
+  // Refuses (403) a request PageAccess refuses, naming why; reported on opts.log too.
+  httplib::Server::HandlerResponse check_access(const httplib::Request& req, httplib::Response& res) {
+    const std::string why = access.refusal(req.path, {req.get_header_value("Host"), req.get_header_value("Origin"),
+                                                      req.get_header_value("Sec-Fetch-Site"),
+                                                      req.get_header_value(PageAccess::kTokenHeader)});
+    if (why.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    send_json(res, {{"error", why}}, 403);
+    if (opts.log) {
+      const std::lock_guard lock(log_mutex);
+      *opts.log << "prizma-relight: refused " << req.method << " " << req.path << ": " << why << std::endl;
+    }
+    return httplib::Server::HandlerResponse::Handled;
+  }
 
   // The request's state keys (light.*, exposure, cmf, display, adapt): every parameter not in `own`.
   RelightSettings settings_of(const httplib::Request& req, std::initializer_list<const char*> own) const {
@@ -262,22 +352,20 @@ struct RelightServer::Impl {
 };
 
 void RelightServer::Impl::routes() {
-  server.set_payload_max_length(std::size_t{1} << 16);
-  server.set_read_timeout(10, 0);
-  server.set_keep_alive_max_count(1000);
+  const ConnectionLimits limits;
+  server.set_payload_max_length(kMaxBodyBytes);
+  // What the Keep-Alive header announces; the pool enforces it.
+  server.set_keep_alive_timeout(std::chrono::duration_cast<std::chrono::seconds>(limits.request_time).count());
+  server.set_keep_alive_max_count(static_cast<std::size_t>(limits.max_requests));
+  // Not listed, so not allowed: frames (no page may embed this one), plugins, forms' targets elsewhere.
   server.set_default_headers({{"Cache-Control", "no-store"},
                               {"X-Content-Type-Options", "nosniff"},
-                              {"Content-Security-Policy", "default-src 'self'; style-src 'self' 'unsafe-inline'"}});
-  // Bound to loopback, only requests that name a loopback host (no DNS rebinding from other sites).
+                              {"Referrer-Policy", "no-referrer"},
+                              {"Content-Security-Policy",
+                               "default-src 'self'; style-src 'self' 'unsafe-inline'; object-src 'none'; "
+                               "base-uri 'none'; form-action 'none'; frame-ancestors 'none'"}});
   server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    if (!is_loopback_address(opts.bind)) return httplib::Server::HandlerResponse::Unhandled;
-    const std::string host = req.get_header_value("Host");
-    const std::string p = ":" + std::to_string(port);
-    for (const char* h : {"127.0.0.1", "localhost", "[::1]"}) {
-      if (host == h + p) return httplib::Server::HandlerResponse::Unhandled;
-    }
-    send_json(res, {{"error", "Host \"" + host + "\" is not this server's loopback address"}}, 403);
-    return httplib::Server::HandlerResponse::Handled;
+    return check_access(req, res);
   });
   server.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
     if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
@@ -290,9 +378,11 @@ void RelightServer::Impl::routes() {
       res.set_content(std::string(detail::web_asset("index.html")), "text/html; charset=utf-8");
     });
   }
-  server.Get("/app\\.js", [](const httplib::Request&, httplib::Response& res) {
-    res.set_content(std::string(detail::web_asset("app.js")), "text/javascript; charset=utf-8");
-  });
+  for (const auto& [route, script] : {std::pair{"/app\\.js", "app.js"}, std::pair{"/state\\.js", "state.js"}}) {
+    server.Get(route, [script = script](const httplib::Request&, httplib::Response& res) {
+      res.set_content(std::string(detail::web_asset(script)), "text/javascript; charset=utf-8");
+    });
+  }
   server.Get("/api/info", guarded([this](const httplib::Request&, httplib::Response& res) {
     const std::lock_guard lock(mutex);
     send_json(res, info());
@@ -355,32 +445,33 @@ void RelightServer::Impl::routes() {
   server.Post("/api/save", guarded([this](const httplib::Request& req, httplib::Response& res) {
     if (!req.has_param("file")) throw InputError("file", "missing");
     const std::string name = req.get_param_value("file");
-    if (!std::regex_match(name, kSaveName)) {
-      throw InputError("file", "\"" + name + "\" is not a plain file name (letters, digits, '.', '_', '-')");
-    }
-    output_format_for(name, "file");
     const std::lock_guard lock(mutex);
     apply_state(req, {"file"});
-    const fs::path path = opts.save_dir / name;
-    session.save(path);
+    const fs::path path = save_folder.save(name, [this](const fs::path& p) { session.save(p); });
     send_json(res, {{"file", name}, {"path", path.string()}, {"state", state_string(session.settings(), session)}});
   }));
+  pool = std::make_unique<ConnectionPool>(limits, [this](Connection& c) {
+    ConnectionStream stream(c);
+    return server.serve_request(stream, c.last_request());
+  });
+  server.pool = pool.get();
+  server.new_task_queue = [this] { return new PoolQueue(*pool); };
 }
 
-RelightServer::RelightServer(RelightSession& session, const ServeOptions& opts)
-    : m_impl(std::make_unique<Impl>(session, opts)) {
-  std::error_code ec;
-  if (!fs::is_directory(opts.save_dir, ec)) {
-    throw InputError("--save-dir", "\"" + opts.save_dir.string() + "\" is not an existing folder");
-  }
-  if (::access(opts.save_dir.c_str(), W_OK | X_OK) != 0) {
-    throw InputError("--save-dir", "folder \"" + opts.save_dir.string() + "\" is not writable");
-  }
+RelightServer::RelightServer(RelightSession& session, const ServeOptions& opts) {
   if (opts.port < 0 || opts.port > 65535) {
     throw InputError("--port", "must be in [0, 65535], not " + std::to_string(opts.port));
   }
+  m_impl = std::make_unique<Impl>(session, opts);  // checks --save-dir
   session.display();  // the starting display must exist before the page asks for it
   m_impl->routes();
+  // httplib's default socket options set SO_REUSEPORT, with which a second server on the same port
+  // starts and the kernel shares the connections between the two: SO_REUSEADDR alone (a port in
+  // TIME_WAIT may be reused, one that is listened on may not).
+  m_impl->server.set_socket_options([](socket_t sock) {
+    const int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   if (opts.port == 0) {
     m_impl->port = m_impl->server.bind_to_any_port(opts.bind);
   } else if (m_impl->server.bind_to_port(opts.bind, opts.port)) {
@@ -389,9 +480,10 @@ RelightServer::RelightServer(RelightSession& session, const ServeOptions& opts)
     m_impl->port = -1;
   }
   if (m_impl->port <= 0) {
-    throw spectral::RuntimeError("--bind " + opts.bind + " --port " + std::to_string(opts.port) +
-                                 ": cannot listen there (address not local, or port in use)");
+    throw InputError("--bind " + opts.bind + " --port " + std::to_string(opts.port),
+                     "cannot listen there (address not local, or port in use)");
   }
+  m_impl->access = PageAccess(m_impl->access.token(), opts.bind, m_impl->port);
 }
 
 RelightServer::~RelightServer() { stop(); }
@@ -401,7 +493,8 @@ int RelightServer::port() const { return m_impl->port; }
 std::string RelightServer::url() const {
   const std::string& host = m_impl->opts.bind;
   const bool v6 = host.find(':') != std::string::npos;
-  return "http://" + (v6 ? "[" + host + "]" : host) + ":" + std::to_string(m_impl->port) + "/";
+  return "http://" + (v6 ? "[" + host + "]" : host) + ":" + std::to_string(m_impl->port) + "/#token=" +
+         m_impl->access.token();
 }
 
 void RelightServer::run() {

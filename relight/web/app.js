@@ -6,6 +6,7 @@
 // Bispectral (fluorescent) files: each light has more texture layers after its bins, its per-pixel
 // re-radiation weights K for the current observer (fetched again when the observer changes), with
 // weights from the server (wr), so the shader adds the re-radiated light in the same sum.
+// The URL fragment's text (the run's secret, the state ⇄ the controls' values) is state.js's.
 'use strict';
 
 const canvas = document.getElementById('relit');
@@ -26,69 +27,51 @@ function groupsPerLight() { return info.groups + (info.reradiation ? info.reradi
 
 // ---------- server calls ----------
 
+const { enc, splitFragment, specOf } = PrizmaState;
+const kTokenKey = 'prizma-relight-token';
+let token = null;      // the run's secret: from the URL's fragment, kept in this tab's sessionStorage
+
+// Every API request carries the secret in a header (page_access.h): a page elsewhere cannot send it.
+async function request(path, query, method) {
+  const headers = token ? { 'X-Prizma-Token': token } : {};
+  const r = await fetch(path + (query ? '?' + query : ''), { method: method || 'GET', headers });
+  if (r.status === 403) {
+    const body = await r.json().catch(() => ({}));
+    throw new Error('the server refused this page: ' + (body.error || 'HTTP 403'));
+  }
+  return r;
+}
+
 async function api(path, query, method) {
-  const r = await fetch(path + (query ? '?' + query : ''), { method: method || 'GET' });
+  const r = await request(path, query, method);
   const body = await r.json();
   if (!r.ok) throw new Error(body.error || ('HTTP ' + r.status));
   return body;
 }
 
-function enc(v) { return encodeURIComponent(v).replace(/%3A/g, ':'); }
-
 // ---------- state: URL fragment ↔ controls ----------
 
-function parseQuery(q) {
-  const out = [];
-  for (const part of q.split('&')) {
-    if (!part) continue;
-    const eq = part.indexOf('=');
-    const k = decodeURIComponent(eq < 0 ? part : part.slice(0, eq));
-    const v = decodeURIComponent(eq < 0 ? '' : part.slice(eq + 1).replace(/\+/g, ' '));
-    out.push([k, v]);
+// Takes the secret out of the fragment (into sessionStorage, so a reload of a state-only URL in this
+// tab still works) and leaves only the state in the address bar, the history and data-state.
+function takeToken() {
+  const { token: t, state } = splitFragment(location.hash);
+  if (t) {
+    token = t;
+    try { sessionStorage.setItem(kTokenKey, t); } catch (e) { /* storage off: this load still works */ }
+  } else if (!token) {
+    try { token = sessionStorage.getItem(kTokenKey); } catch (e) { token = null; }
   }
-  return out;
+  if (location.hash !== (state ? '#' + state : '')) {
+    history.replaceState(null, '', location.pathname + location.search + (state ? '#' + state : ''));
+  }
 }
 
-// A spec → controls: kind (named / blackbody / gaussian / custom), its parameters, scale, on.
-function parseSpec(text, prev) {
-  const l = Object.assign({ on: true, kind: 'named', named: 'D65', temp: 3200, centre: 550, fwhm: 40,
-                            custom: '', scale: 1 }, prev || {});
-  if (text === 'off') { l.on = false; return l; }
-  l.on = true;
-  let base = text, scale = 1, m;
-  while ((m = /^(.*)\*([0-9.eE+-]+)$/.exec(base)) && isFinite(Number(m[2]))) { base = m[1]; scale *= Number(m[2]); }
-  l.scale = scale;
-  if (info.spectra.includes(base)) { l.kind = 'named'; l.named = base; }
-  else if ((m = /^blackbody:([0-9.]+)K?$/i.exec(base))) { l.kind = 'blackbody'; l.temp = Number(m[1]); }
-  else if ((m = /^gaussian:([0-9.]+):([0-9.]+)$/.exec(base))) { l.kind = 'gaussian'; l.centre = Number(m[1]); l.fwhm = Number(m[2]); }
-  else { l.kind = 'custom'; l.custom = base; }
-  return l;
-}
-
-function specOf(l) {
-  if (!l.on) return 'off';
-  let base;
-  switch (l.kind) {
-    case 'named': base = l.named; break;
-    case 'blackbody': base = 'blackbody:' + l.temp + 'K'; break;
-    case 'gaussian': base = 'gaussian:' + l.centre + ':' + l.fwhm; break;
-    default: base = l.custom;
-  }
-  return Number(l.scale) === 1 ? base : base + '*' + l.scale;
-}
+function parseSpec(text, prev) { return PrizmaState.parseSpec(text, info.spectra, prev); }
 
 // Controls from a fragment: the server's starting state first, then the fragment's keys.
 function stateToControls(fragment) {
-  const s = { exposure: 0, cmf: '1931', display: 'sRGB', adapt: false };
-  for (const [k, v] of parseQuery(info.state).concat(parseQuery(fragment))) {
-    if (k.startsWith('light.')) {
-      const name = k.slice(6);
-      if (name in uiLights) uiLights[name] = parseSpec(v, uiLights[name]);
-    } else if (k === 'exposure') s.exposure = Number(v);
-    else if (k === 'cmf') s.cmf = v;
-    else if (k === 'display') s.display = v;
-    else if (k === 'adapt') s.adapt = v === '1' || v === 'on' || v === 'true';
-  }
+  const s = PrizmaState.stateValues(info.state, fragment, info.lights.map((l) => l.name));
+  for (const [name, spec] of Object.entries(s.lights)) uiLights[name] = parseSpec(spec, uiLights[name]);
   $('exposure').value = s.exposure; $('exposure_n').value = s.exposure;
   $('cmf').value = s.cmf; $('display').value = s.display; $('adapt').checked = s.adapt;
   for (const name of Object.keys(uiLights)) syncLightControls(name);
@@ -96,15 +79,11 @@ function stateToControls(fragment) {
 }
 
 function controlsToState() {
-  const parts = info.lights.map((l) => 'light.' + enc(l.name) + '=' + enc(specOf(uiLights[l.name])));
-  parts.push('exposure=' + enc(String(Number($('exposure_n').value))));
-  parts.push('cmf=' + enc($('cmf').value));
-  parts.push('display=' + enc($('display').value));
-  parts.push('adapt=' + ($('adapt').checked ? '1' : '0'));
-  return parts.join('&');
+  return PrizmaState.stateString(info.lights.map((l) => [l.name, specOf(uiLights[l.name])]), {
+    exposure: $('exposure_n').value, cmf: $('cmf').value, display: $('display').value, adapt: $('adapt').checked });
 }
 
-function currentFragment() { return location.hash.replace(/^#/, ''); }
+function currentFragment() { return splitFragment(location.hash).state; }
 
 function onControlChange() {
   const frag = controlsToState();
@@ -357,7 +336,7 @@ async function uploadTransport() {
 
 async function uploadLayer(l, g, type, cmf) {
   const half = type === 'f16';
-  const r = await fetch('/api/transport?light=' + l + '&group=' + g + '&type=' + type + (cmf ? '&cmf=' + enc(cmf) : ''));
+  const r = await request('/api/transport', 'light=' + l + '&group=' + g + '&type=' + type + (cmf ? '&cmf=' + enc(cmf) : ''));
   if (!r.ok) throw new Error('transport: HTTP ' + r.status);
   const buf = await r.arrayBuffer();
   const data = half ? new Uint16Array(buf) : new Float32Array(buf);
@@ -456,11 +435,7 @@ async function pump() {
   busy = false;
 }
 
-function stateValue(frag, key, fallback) {
-  let d = fallback;
-  for (const [k, v] of parseQuery(info.state).concat(parseQuery(frag))) if (k === key) d = v;
-  return d;
-}
+function stateValue(frag, key, fallback) { return PrizmaState.stateValue(info.state, frag, key, fallback); }
 
 function stateDisplay(frag) { return stateValue(frag, 'display', 'sRGB'); }
 
@@ -615,6 +590,7 @@ window.prizmaBench = {
 
 async function main() {
   try {
+    takeToken();
     info = await api('/api/info');
     $('title').textContent = info.source + ' — ' + info.width + '×' + info.height + ', ' + (info.bins.length - 1) +
                              ' bins ' + info.bins[0] + '–' + info.bins[info.bins.length - 1] + ' nm, lights ' +
@@ -631,7 +607,11 @@ async function main() {
     $('title').textContent = info.source + ' — ' + info.width + '×' + info.height + ', ' + (info.bins.length - 1) +
                              ' bins, lights ' + info.lights.map((l) => l.name).join(', ') + ' (prizma ' +
                              info.version + ')';
-    window.addEventListener('hashchange', () => { stateToControls(currentFragment()); requestRender(currentFragment()); });
+    window.addEventListener('hashchange', () => {
+      takeToken();
+      stateToControls(currentFragment());
+      requestRender(currentFragment());
+    });
     if (!currentFragment()) history.replaceState(null, '', '#' + info.state);
     stateToControls(currentFragment());
     requestRender(currentFragment());

@@ -1,6 +1,8 @@
-# prizma-relight --serve: the HTTP server's answers to bad requests (label "serve"), and the live page
-# in headless Chromium against prizma-relight -o (label "browser"; skipped, exit 77, when chromium,
-# chromium-driver or python3-selenium are missing). Driver: browser/live_page_test.py.
+# prizma-relight --serve: the HTTP server through plain sockets (label "serve"), and the live page in
+# headless Chromium against prizma-relight -o and against pages of other origins (label "browser";
+# skipped, exit 77, when chromium, chromium-driver or python3-selenium are missing, failed then with
+# CI=true: tests/missing-tool). Driver: browser/live_page_test.py. The page's state handling
+# (relight/web/state.js) under node's test runner (Debian's nodejs): relight.live.page_state.
 if(NOT TARGET prizma-relight)
   return()
 endif()
@@ -34,3 +36,11 @@ foreach(mode server browser)
 endforeach()
 set_tests_properties(relight.live.server PROPERTIES LABELS serve)
 set_tests_properties(relight.live.browser PROPERTIES LABELS browser)
+
+find_program(PRIZMA_NODE NAMES node nodejs)
+if(PRIZMA_NODE)
+  add_test(NAME relight.live.page_state COMMAND ${PRIZMA_NODE} --test ${PRIZMA_E2E_DIR}/browser/state_test.js)
+else()
+  prizma_missing_tool_test(relight.live.page_state "node (apt-get install nodejs)")
+endif()
+set_tests_properties(relight.live.page_state PROPERTIES LABELS browser)

@@ -56,6 +56,14 @@ prizma_relight_e2e(err_unwritable "scene.exr|-o|no/such/folder/out.png" EXPECT_R
 prizma_relight_e2e(err_unknown_format "scene.exr|-o|err7.bmp" EXPECT_RC 2 ERR_REGEX "unknown output format" MUST_NOT_EXIST err7.bmp)
 prizma_relight_e2e(err_bad_cmf "scene.exr|--cmf|1955|-o|err8.png" EXPECT_RC 2 ERR_REGEX "--cmf" MUST_NOT_EXIST err8.png)
 prizma_relight_e2e(err_bad_display "scene.exr|--display|NoSuchDisplay|-o|err9.png" EXPECT_RC 2 ERR_REGEX "NoSuchDisplay" MUST_NOT_EXIST err9.png)
+# The live page's options without --serve (errors.md, "Options that nothing would use").
+foreach(opt --bind|127.0.0.1 --port|8123 --save-dir|.)
+  string(REGEX REPLACE "\\|.*" "" _name "${opt}")
+  string(REPLACE "--" "" _short "${_name}")
+  string(REPLACE "-" "_" _short "${_short}")
+  prizma_relight_e2e(err_${_short}_needs_serve "scene.exr|${opt}|-o|serve_${_short}.png" EXPECT_RC 2
+    ERR_REGEX "^prizma-relight: error: ${_name}: only with --serve" MUST_NOT_EXIST serve_${_short}.png)
+endforeach()
 prizma_relight_e2e(err_existing_output_survives "scene.exr|--light|key=nope|-o|existing.png" EXPECT_RC 2
   ERR_REGEX "nope" KEEP_FILE existing.png KEEP_CONTENT "keep me")
 prizma_relight_e2e(err_light_twice "scene.exr|--light|key=D65|--light|key=A|-o|err10.png" EXPECT_RC 2

@@ -1,6 +1,7 @@
 # A real one-node Slurm cluster (tests/e2e/slurm/slurm-cluster): the job array of docs/distributed.md,
 # one task preempted with SIGTERM and requeued (--resume), merged, equal to a one-machine render.
-# Label "slurm"; skipped (exit 77) when not root or slurm-wlm/munge are missing. Bounded: 15 min.
+# Label "slurm"; skipped (exit 77) when not root or slurm-wlm/munge are missing, failed then with
+# CI=true (tests/missing-tool). Bounded: 15 min.
 # Also: the job script shown in docs/distributed.md is byte for byte scripts/slurm/render-shards.sbatch.
 if(NOT TARGET prizma-render OR NOT TARGET prizma-test-exr-compare)
   return()

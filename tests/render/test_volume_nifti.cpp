@@ -12,6 +12,7 @@
 #include <iterator>
 #include <limits>
 
+#include "missing_tool.h"
 #include "prizma/render/volume.h"
 #include "prizma/spectral/error.h"
 #include "test_scene_util.h"
@@ -208,7 +209,7 @@ TEST(NiftiVolume, ReadsColin27Template) {
   // ch2.nii.gz is 181×217×181 at 1 mm. Reference: their headers, read with Python's gzip.
   const std::filesystem::path better = "/usr/share/mricron/templates/ch2better.nii.gz";
   const std::filesystem::path ch2 = "/usr/share/mricron/templates/ch2.nii.gz";
-  if (!std::filesystem::exists(better) || !std::filesystem::exists(ch2)) GTEST_SKIP() << "mricron-data is not installed";
+  if (!std::filesystem::exists(better) || !std::filesystem::exists(ch2)) PRIZMA_MISSING_TOOL("mricron-data");
   const Volume vb = load_nifti_volume(better);
   EXPECT_EQ(vb.dims, (std::array<int, 3>{301, 370, 316}));
   EXPECT_EQ(vb.spacing, (std::array<double, 3>{0.5, 0.5, 0.5}));

@@ -30,7 +30,7 @@ def main():
             opts.add_argument(flag)
         browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=opts)
         try:
-            browser.get(url + ("#" + state if state else ""))
+            browser.get(url + ("&" + state if state else ""))  # url: …/#token=SECRET
             for _ in range(600):
                 frame = browser.execute_script("return document.getElementById('relit').dataset.frame")
                 if frame and int(frame) >= 1:
