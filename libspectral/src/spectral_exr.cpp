@@ -193,10 +193,10 @@ void check_finite(const std::vector<float>& values, int width, int bins, const s
   }
 }
 
-std::string default_lights_json(const SpectralImage& image) {
-  nlohmann::json arr = nlohmann::json::array();
-  for (const auto& l : image.lights) arr.push_back({{"name", l.name}});
-  return arr.dump();
+std::vector<std::string> layer_names(const SpectralImage& image) {
+  std::vector<std::string> names;
+  for (const auto& l : image.lights) names.push_back(l.name);
+  return names;
 }
 
 void put_int_or_string(Imf::Header& header, const char* name, std::int64_t v) {
@@ -279,9 +279,6 @@ std::vector<float> sum_of_lights(const SpectralImage& image) {
 // left on another machine) is left out, as prizma-relight leaves it off; empty when every light is,
 // or the CIE tables cannot be read.
 std::vector<float> preview_rgb(const SpectralImage& image) {
-  const nlohmann::json recorded = image.info.lights_json.empty()
-                                      ? nlohmann::json::array()
-                                      : nlohmann::json::parse(image.info.lights_json, nullptr, false);
   const ColorMatching* cmf = nullptr;
   try {
     cmf = &ColorMatching::get(Observer::Cie1931_2deg);
@@ -294,14 +291,7 @@ std::vector<float> preview_rgb(const SpectralImage& image) {
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> rerad;    // per light, RGB ← bispectral pairs
   bool any = false;
   for (const auto& layer : image.lights) {
-    std::string spec = "D65";  // RelightSession's rule: the entry named after the layer, or the only one
-    if (recorded.is_array()) {
-      for (const auto& entry : recorded) {
-        if (!entry.is_object() || !entry.contains("spectrum") || !entry["spectrum"].is_string()) continue;
-        const std::string name = entry.value("name", std::string());
-        if (name == layer.name || (image.lights.size() == 1 && recorded.size() == 1)) spec = entry["spectrum"].get<std::string>();
-      }
-    }
+    const std::string spec = default_spectrum(image.info.light_records, layer.name, image.lights.size());
     Eigen::Matrix<double, 3, Eigen::Dynamic> w = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, n);
     Eigen::Matrix<double, 3, Eigen::Dynamic> r =
         Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, static_cast<Eigen::Index>(image.reradiation.size()));
@@ -533,8 +523,9 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
     header.insert(kAttrEdgesExact, Imf::StringAttribute(exact));
   }
   const SpectralExrInfo& info = image.info;
-  header.insert(kAttrLights, Imf::StringAttribute(info.lights_json.empty() ? default_lights_json(image)
-                                                                            : info.lights_json));
+  check_light_records(info.light_records, layer_names(image), p);
+  header.insert(kAttrLights, Imf::StringAttribute(light_records_json(
+                                 info.light_records.empty() ? light_records_for(layer_names(image)) : info.light_records)));
   put_int_or_string(header, kAttrSamples, info.samples);
   put_int_or_string(header, kAttrSeed, info.seed);
   if (!info.sample_range.empty()) header.insert(kAttrSampleRange, Imf::StringAttribute(info.sample_range));
@@ -928,7 +919,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     for (auto it = header.begin(); it != header.end(); ++it) {
       if (std::string_view(it.name()).rfind("prizma:", 0) == 0) info.is_prizma = true;
     }
-    if (const auto* s = find_string_attr(header, kAttrLights)) info.lights_json = *s;
+    if (const auto* s = find_string_attr(header, kAttrLights)) info.light_records = parse_light_records(*s, p + ": " + kAttrLights);
     if (const auto* s = find_string_attr(header, kAttrSampleRange)) info.sample_range = *s;
     if (const auto* s = find_string_attr(header, kAttrSceneHash)) info.scene_hash = *s;
     if (const auto* s = find_string_attr(header, kAttrVersion)) info.version = *s;
@@ -937,12 +928,6 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     if (const auto* s = find_string_attr(header, kAttrRenderOptions)) info.render_options = *s;
     info.samples = int_attr(header, kAttrSamples, p);
     info.seed = int_attr(header, kAttrSeed, p);
-    nlohmann::json lights_json;
-    if (!info.lights_json.empty()) {
-      check_json_depth(info.lights_json, p + ": " + kAttrLights);
-      lights_json = nlohmann::json::parse(info.lights_json, nullptr, /*allow_exceptions=*/false);
-      if (lights_json.is_discarded()) throw InputError(p, std::string(kAttrLights) + " is not valid JSON");
-    }
 
     // Light layers: named layers (not variance) if any, else the top-level layer.
     auto is_variance = [](const std::string& layer) {
@@ -969,11 +954,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     }
     // JSON order of the lights when it names exactly these layers (the file's channels are sorted).
     std::vector<std::string> json_names;
-    if (lights_json.is_array()) {
-      for (const auto& l : lights_json) {
-        if (l.is_object() && l.contains("name") && l["name"].is_string()) json_names.push_back(l["name"]);
-      }
-    }
+    for (const LightRecord& r : info.light_records) json_names.push_back(r.name);
     if (!light_layers.empty()) {
       std::vector<std::string> sorted_json = json_names;
       std::sort(sorted_json.begin(), sorted_json.end());
@@ -997,6 +978,11 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
       std::string name = "default";
       if (json_names.size() == 1 && valid_light_name(json_names.front())) name = json_names.front();
       sources.push_back({name, "", layers.count(kVarianceLayer) ? std::string(kVarianceLayer) : std::string()});
+    }
+    {
+      std::vector<std::string> names;
+      for (const auto& s : sources) names.push_back(s.name);
+      check_light_records(info.light_records, names, p);
     }
 
     // Every light (and the top level and variance layers) must carry the same wavelengths.

@@ -112,7 +112,7 @@ py::dict image_to_py(spectral::SpectralImage&& image) {
   a["wavelength_sampling"] = info.wavelength_sampling;
   a["scene_path"] = info.scene_path;
   a["render_options"] = info.render_options;
-  a["lights_json"] = info.lights_json;
+  a["lights_json"] = spectral::light_records_json(info.light_records);
   a["is_prizma"] = info.is_prizma;
   out["attributes"] = a;
   return out;
@@ -225,7 +225,8 @@ spectral::SpectralImage image_from_py(const py::dict& d) {
   info.wavelength_sampling = attribute_or<std::string>(attrs, "wavelength_sampling", "");
   info.scene_path = attribute_or<std::string>(attrs, "scene_path", "");
   info.render_options = attribute_or<std::string>(attrs, "render_options", "");
-  info.lights_json = attribute_or<std::string>(attrs, "lights_json", "");
+  if (const std::string text = attribute_or<std::string>(attrs, "lights_json", ""); !text.empty())
+    info.light_records = spectral::parse_light_records(text, "attributes[\"lights\"]");
   info.is_prizma = true;
   return image;
 }

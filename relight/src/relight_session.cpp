@@ -1,7 +1,5 @@
 #include "prizma/relight/relight_session.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -24,46 +22,15 @@ struct DefaultLights {
   std::vector<std::string> errors;
 };
 
-// Default light per layer: the spectrum recorded in prizma:lights for that name, else D65. A recorded
-// spectrum that does not parse here (e.g. "csv:lamp.csv" rendered on another machine) does not stop the
-// file from opening: that layer gets an "off" placeholder carrying the recorded text, and relighting
-// fails only if the user leaves it in place.
+// Default light per layer (spectral::default_spectrum). A recorded spectrum that does not parse here
+// (e.g. "csv:lamp.csv" rendered on another machine) does not stop the file from opening: that layer
+// gets an "off" placeholder carrying the recorded text, and relighting fails only if the user leaves
+// it in place. (The reader has checked that the records describe the layers.)
 DefaultLights read_default_lights(const spectral::SpectralImage& image, const std::vector<std::string>& names,
                                   const std::string& source) {
-  nlohmann::json lights = nlohmann::json::array();
-  if (!image.info.lights_json.empty()) {
-    try {
-      lights = nlohmann::json::parse(image.info.lights_json);
-    } catch (const nlohmann::json::exception& e) {
-      throw InputError(source, std::string("prizma:lights is not valid JSON: ") + e.what());
-    }
-  }
-  // A file that announces two or more lights must hold a layer for each of them.
-  if (lights.is_array() && lights.size() >= 2) {
-    for (const auto& entry : lights) {
-      const std::string name = entry.is_object() ? entry.value("name", std::string()) : std::string();
-      if (std::find(names.begin(), names.end(), name) == names.end()) {
-        std::string known;
-        for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-        throw InputError(source, "prizma:lights announces light \"" + name + "\" but the file has no layer for it (layers: " +
-                                     known + ")");
-      }
-    }
-  }
   DefaultLights out;
   for (std::size_t l = 0; l < names.size(); ++l) {
-    std::string spec = "D65";
-    if (lights.is_array()) {
-      for (std::size_t j = 0; j < lights.size(); ++j) {
-        const auto& entry = lights[j];
-        if (!entry.is_object() || !entry.contains("spectrum") || !entry["spectrum"].is_string()) continue;
-        const std::string name = entry.value("name", std::string());
-        // A single-layer file: its one light is the layer whatever its name.
-        if (name == image.lights[l].name || (names.size() == 1 && lights.size() == 1)) {
-          spec = entry["spectrum"].get<std::string>();
-        }
-      }
-    }
+    const std::string spec = spectral::default_spectrum(image.info.light_records, image.lights[l].name, names.size());
     const std::string context = source + ": prizma:lights " + names[l];
     try {
       out.lights.push_back(parse_light_spec(spec, {context, {}}));
@@ -107,7 +74,10 @@ RelightSession::RelightSession(spectral::SpectralImage image, std::string source
       m_compressed = std::make_unique<CompressedTransport>(take_coefficients(m_image, m_source));
     }
   }
-  for (const auto& layer : m_image.lights) m_light_names.push_back(layer.name.empty() ? "T" : layer.name);
+  std::vector<std::string> layer_names;
+  for (const auto& layer : m_image.lights) layer_names.push_back(layer.name);
+  spectral::check_light_records(m_image.info.light_records, layer_names, m_source);  // images made in memory
+  for (const auto& name : layer_names) m_light_names.push_back(name.empty() ? "T" : name);
   DefaultLights defaults = read_default_lights(m_image, m_light_names, m_source);
   m_default_lights = std::move(defaults.lights);
   m_default_errors = std::move(defaults.errors);
@@ -295,16 +265,16 @@ void RelightSession::save(const std::filesystem::path& path) {
 }
 
 ImageMetadata RelightSession::metadata() const {
-  nlohmann::json lights = nlohmann::json::array();
+  std::vector<spectral::LightRecord> lights;
   for (std::size_t l = 0; l < m_light_names.size(); ++l) {
-    lights.push_back({{"name", m_light_names[l]}, {"spectrum", m_settings.lights[l].text}});
+    lights.push_back({.name = m_light_names[l], .spectrum = m_settings.lights[l].text});
   }
   std::ostringstream exposure;
   exposure << m_settings.relight.exposure_ev;
   ImageMetadata md = {
       {"Software", "prizma-relight " + spectral::prizma_version()},
       {"prizma:source", m_source},
-      {"prizma:lights", lights.dump()},
+      {"prizma:lights", spectral::light_records_json(lights)},
       {"prizma:exposureEV", exposure.str()},
       {"prizma:cmf", spectral::observer_name(m_settings.relight.cmf)},
       {"prizma:units", m_settings.relight.units == spectral::LightUnits::Absolute ? "absolute" : "relative-to-white"},

@@ -1,4 +1,4 @@
-// merge_shards() and the prizma:lights JSON.
+// merge_shards() and the scene's lights as prizma:lights records.
 #include <algorithm>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -34,53 +34,42 @@ std::string merged_options(const std::vector<spectral::SpectralImage>& shards,
 
 }  // namespace
 
-std::string lights_to_json(const std::vector<Light>& lights) {
-  nlohmann::json arr = nlohmann::json::array();
+std::vector<spectral::LightRecord> light_records(const std::vector<Light>& lights) {
+  const auto array3 = [](const Eigen::Vector3d& v) { return std::array<double, 3>{v.x(), v.y(), v.z()}; };
+  std::vector<spectral::LightRecord> out;
   for (const Light& l : lights) {
-    arr.push_back({{"name", l.name},
-                   {"direction", {l.direction.x(), l.direction.y(), l.direction.z()}},
-                   {"angularSizeDeg", l.angular_size_deg},
-                   {"spectrum", l.spectrum_spec}});
-    if (l.emission) arr.back()["emission"] = true;  // only then: files without emission unchanged
-    if (l.is_point) {  // point, sphere and spot lights (only then, as emission)
-      auto& j = arr.back();
-      j["position"] = {l.position.x(), l.position.y(), l.position.z()};
-      if (l.radius > 0.0) j["radius"] = l.radius;
+    spectral::LightRecord& r = out.emplace_back();
+    r.name = l.name;
+    r.spectrum = l.spectrum_spec;
+    r.direction = array3(l.direction);
+    r.angular_size_deg = l.angular_size_deg;
+    r.emission = l.emission;
+    if (l.is_point) {  // point, sphere and spot lights
+      r.position = array3(l.position);
+      r.radius = l.radius;
       if (l.spot_direction.squaredNorm() > 0.0)
-        j["spot"] = {{"direction", {l.spot_direction.x(), l.spot_direction.y(), l.spot_direction.z()}},
-                     {"coneDeg", l.spot_cone_deg},
-                     {"falloffDeg", l.spot_falloff_deg}};
+        r.spot = spectral::SpotRecord{array3(l.spot_direction), l.spot_cone_deg, l.spot_falloff_deg};
     }
     if (l.environment_map) {
-      arr.back()["environment"] = l.environment_file;
-      arr.back()["rotationDeg"] = l.rotation_deg;
+      r.environment = l.environment_file;
+      r.rotation_deg = l.rotation_deg;
     }
   }
-  return arr.dump();
+  return out;
 }
 
 std::vector<Light> lights_from_image(const spectral::SpectralImage& image) {
   std::vector<Light> out;
-  nlohmann::json arr;
-  try {
-    if (!image.info.lights_json.empty()) arr = nlohmann::json::parse(image.info.lights_json);
-  } catch (const nlohmann::json::exception&) {
-    arr = nlohmann::json();
-  }
   for (const auto& layer : image.lights) {
-    Light l;
+    Light& l = out.emplace_back();
     l.name = layer.name;
-    if (arr.is_array()) {
-      for (const auto& j : arr) {
-        if (!j.is_object() || j.value("name", std::string()) != layer.name) continue;
-        const auto d = j.value("direction", std::vector<double>{0, 0, 0});
-        if (d.size() == 3) l.direction = Eigen::Vector3d(d[0], d[1], d[2]);
-        l.angular_size_deg = j.value("angularSizeDeg", 0.0);
-        l.spectrum_spec = j.value("spectrum", std::string("D65"));
-        l.emission = j.contains("emission") && j.at("emission").is_boolean() && j.at("emission").get<bool>();
-      }
+    for (const spectral::LightRecord& r : image.info.light_records) {
+      if (r.name != layer.name) continue;
+      if (r.direction) l.direction = Eigen::Vector3d((*r.direction)[0], (*r.direction)[1], (*r.direction)[2]);
+      l.angular_size_deg = r.angular_size_deg.value_or(0.0);
+      l.emission = r.emission;
     }
-    out.push_back(l);
+    l.spectrum_spec = spectral::default_spectrum(image.info.light_records, layer.name, image.lights.size());
   }
   return out;
 }
@@ -106,7 +95,7 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
     if (s.info.scene_hash != first.info.scene_hash) refuse("scene hash");
     if (s.info.seed != first.info.seed) refuse("seed");
     if (s.info.wavelength_sampling != first.info.wavelength_sampling) refuse("wavelength sampling");
-    if (s.info.lights_json != first.info.lights_json || s.lights.size() != first.lights.size()) refuse("lights");
+    if (s.info.light_records != first.info.light_records || s.lights.size() != first.lights.size()) refuse("lights");
     for (std::size_t l = 0; l < s.lights.size(); ++l)
       if (s.lights[l].name != first.lights[l].name) refuse("lights");
     if (s.info.samples <= 0) throw InputError(name(k), "holds no samples");

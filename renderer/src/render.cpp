@@ -372,7 +372,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   for (const Light& light : scene.lights) names.push_back(light.name);
   spectral::SpectralImage img = film.image(names);
   img.info.is_prizma = true;
-  img.info.lights_json = lights_to_json(scene.lights);
+  img.info.light_records = light_records(scene.lights);
   img.info.samples = done;
   img.info.sample_range = SampleRange{st.sample_begin, st.sample_begin + done}.to_string();
   img.info.seed = static_cast<std::int64_t>(st.seed);

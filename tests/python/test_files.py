@@ -122,3 +122,20 @@ def test_unwritable_destination_is_an_input_error(tiny_exr, tmp_path):
     with pytest.raises(prizma.InputError) as e:
         prizma.write(tmp_path / "no" / "such" / "folder.exr", image)
     assert "folder.exr" in str(e.value)
+
+
+@pytest.mark.parametrize("lights, message", [
+    ("[{not json", r'attributes\["lights"\]: is not valid JSON'),
+    ([{"name": "key"}, {"spectrum": "D65"}], r'attributes\["lights"\]\[1\]: has no "name"'),
+    ([{"name": "key", "direction": [0, 1]}, {"name": "fill"}],
+     r'attributes\["lights"\]\[0\]: "direction" must be an array of 3 numbers'),
+    ([{"name": "key"}, {"name": "back"}], r'prizma:lights announces light "back" but the file has no layer for it'),
+])
+def test_write_refuses_lights_its_reader_would_refuse(tmp_path, lights, message):
+    # One light record (light_record.h) reads and writes prizma:lights: what write accepts reads back.
+    layers = {"key": np.ones((2, 2, 3), np.float32), "fill": np.ones((2, 2, 3), np.float32)}
+    image = prizma.Image(layers, np.array([400.0, 500.0, 600.0, 700.0]), attributes={"lights": lights})
+    out = tmp_path / "lights.exr"
+    with pytest.raises(prizma.InputError, match=message):
+        prizma.write(out, image)
+    assert not out.exists()

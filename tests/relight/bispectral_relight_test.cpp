@@ -107,7 +107,7 @@ TEST(BispectralRelight, PreviewChannelsIncludeTheReradiation) {
   // light at its recorded spectrum) in linear sRGB: the diagonal and the re-radiated light, here
   // through relight_image's K path against the writer's per-pair sum (spectral_exr.cpp).
   auto img = test::fluorescent_image();
-  img.info.lights_json = R"([{"name":"uv","spectrum":"LED-V1"},{"name":"sky","spectrum":"D65*0.2"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"uv","spectrum":"LED-V1"},{"name":"sky","spectrum":"D65*0.2"}])", "test");
   const std::filesystem::path path =
       std::filesystem::temp_directory_path() / ("prizma-bispectral-preview-" + std::to_string(::getpid()) + ".exr");
   spectral::write_spectral_exr(path, img);

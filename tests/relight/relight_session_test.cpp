@@ -31,8 +31,8 @@ fs::path write_fixture(const fs::path& dir) {
     if (l == 0) return x < 3 ? 0.5f : 0.0f;
     return x >= 3 ? static_cast<float>(i) / 11.0f : 0.0f;
   });
-  img.info.lights_json = R"([{"name":"key","direction":[0,0,1],"angularSizeDeg":0,"spectrum":"D65"},
-                             {"name":"back","direction":[0,1,0],"angularSizeDeg":0,"spectrum":"A*0.5"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"key","direction":[0,0,1],"angularSizeDeg":0,"spectrum":"D65"},
+                             {"name":"back","direction":[0,1,0],"angularSizeDeg":0,"spectrum":"A*0.5"}])", "test");
   const fs::path path = dir / "scene.exr";
   spectral::write_spectral_exr(path, img);
   return path;
@@ -64,7 +64,7 @@ TEST(RelightSession, UnusableRecordedLightFailsOnlyWhenUsed) {
   const fs::path dir = test::scratch_dir("unusable_default");
   const BinLayout bins = BinLayout::linear(400.0, 700.0, 12);
   auto img = test::make_image(6, 4, bins, {"key", "back"}, [](int, int, int) { return 0.5f; });
-  img.info.lights_json = R"([{"name":"key","spectrum":"D65"},{"name":"back","spectrum":"csv:/nowhere/lamp.csv*2"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"key","spectrum":"D65"},{"name":"back","spectrum":"csv:/nowhere/lamp.csv*2"}])", "test");
   const fs::path path = dir / "elsewhere.exr";
   spectral::write_spectral_exr(path, img);
 

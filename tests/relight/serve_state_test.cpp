@@ -12,7 +12,7 @@ namespace {
 RelightSession make_session() {
   auto img = test::make_image(2, 2, spectral::BinLayout::linear(400.0, 700.0, 6), {"side", "back"},
                               [](int, int, int) { return 0.5f; });
-  img.info.lights_json = R"([{"name":"side","spectrum":"D65"},{"name":"back","spectrum":"A*0.5"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"side","spectrum":"D65"},{"name":"back","spectrum":"A*0.5"}])", "test");
   return RelightSession(std::move(img), "mem.exr");
 }
 

@@ -177,7 +177,7 @@ TEST_F(SpectralExr, OneLightRoundTripIsBitExact) {
   img.info.scene_hash = "abc123";
   img.info.version = "test-version";
   img.info.wavelength_sampling = "spectral-tracking";
-  img.info.lights_json = R"([{"name":"sun","direction":[0,0,1],"angularSizeDeg":0.5,"spectrum":"D65"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"sun","direction":[0,0,1],"angularSizeDeg":0.5,"spectrum":"D65"}])", "test");
   const fs::path p = file("one.exr");
   write_spectral_exr(p, img);
 
@@ -215,7 +215,7 @@ TEST_F(SpectralExr, OneLightRoundTripIsBitExact) {
   EXPECT_EQ(back.info.scene_hash, "abc123");
   EXPECT_EQ(back.info.version, "test-version");
   EXPECT_EQ(back.info.wavelength_sampling, "spectral-tracking");
-  EXPECT_EQ(back.info.lights_json, img.info.lights_json);
+  EXPECT_EQ(back.info.light_records, img.info.light_records);
 }
 
 TEST_F(SpectralExr, ThreeLightsWithVarianceRoundTrip) {
@@ -693,7 +693,7 @@ TEST_F(SpectralExr, WritesTheDefaultRelightAsLinearSrgbPreview) {
   SpectralImage img = make_image(3, 2, BinLayout::linear(380, 780, 40), {"a", "b"});
   std::fill(img.lights[0].data.begin(), img.lights[0].data.end(), 1.0f);
   std::fill(img.lights[1].data.begin(), img.lights[1].data.end(), 5.0f);
-  img.info.lights_json = R"([{"name":"a","spectrum":"D65"},{"name":"b","spectrum":"off"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"a","spectrum":"D65"},{"name":"b","spectrum":"off"}])", "test");
   const fs::path p = file("preview.exr");
   write_spectral_exr(p, img);
   {
@@ -790,10 +790,27 @@ TEST_F(SpectralExr, ReadsPlainMultiLayerFileAsLights) {
 
 TEST_F(SpectralExr, RefusesInvalidLightsJson) {
   SpectralImage img = make_image(1, 1, BinLayout::linear(400, 700, 2), {"a"});
-  img.info.lights_json = "[{not json";
-  const fs::path p = file("json.exr");
-  write_spectral_exr(p, img);
-  EXPECT_NE(read_error(p).find("prizma:lights"), std::string::npos);
+  write_spectral_exr(file("ok.exr"), img);
+  const fs::path p = rewrite_header(file("ok.exr"), file("json.exr"), [](Imf::Header& h) {
+    h.insert("prizma:lights", Imf::StringAttribute("[{not json"));
+  });
+  const std::string err = read_error(p);
+  EXPECT_NE(err.find("prizma:lights: is not valid JSON"), std::string::npos) << err;
+}
+
+// One light record, one reader and writer (light_record.h): the writer refuses records its reader would.
+TEST_F(SpectralExr, WriterRefusesLightRecordsThatDoNotDescribeTheLayers) {
+  SpectralImage img = make_image(1, 1, BinLayout::linear(400, 700, 2), {"key", "fill"});
+  img.info.light_records = light_records_for({"key", "back"});
+  const fs::path p = file("records.exr");
+  try {
+    write_spectral_exr(p, img);
+    FAIL() << "written";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), p.string() + ": prizma:lights announces light \"back\" but the file has no layer "
+                                                  "for it (layers: key, fill)");
+  }
+  EXPECT_FALSE(fs::exists(p));
 }
 
 TEST_F(SpectralExr, ReadsDataWindowNotAtOrigin) {
@@ -898,9 +915,10 @@ TEST_F(SpectralExr, RefusesNonRegularFiles) {
 // issue 11: a deeply nested prizma:lights record is refused (nlohmann recurses on such values).
 TEST_F(SpectralExr, RefusesDeeplyNestedLightsJson) {
   SpectralImage img = make_image(1, 1, BinLayout::linear(400, 700, 2), {"a"});
-  img.info.lights_json = std::string(70000, '[') + std::string(70000, ']');
-  const fs::path p = file("deep.exr");
-  write_spectral_exr(p, img);
+  write_spectral_exr(file("ok.exr"), img);
+  const fs::path p = rewrite_header(file("ok.exr"), file("deep.exr"), [](Imf::Header& h) {
+    h.insert("prizma:lights", Imf::StringAttribute(std::string(70000, '[') + std::string(70000, ']')));
+  });
   const std::string err = read_error(p);
   EXPECT_NE(err.find("prizma:lights: JSON nested deeper than"), std::string::npos) << err;
 }

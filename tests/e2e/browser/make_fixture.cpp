@@ -42,8 +42,8 @@ SpectralImage two_lights(int width, int height, int bins) {
         img.lights[1].data[k] = static_cast<float>(r * r * back);
       }
     }
-  img.info.lights_json = R"([{"name":"side","direction":[-1,0,1],"angularSizeDeg":0,"spectrum":"D65"},)"
-                         R"({"name":"back","direction":[1,0,0.2],"angularSizeDeg":0,"spectrum":"A"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"side","direction":[-1,0,1],"angularSizeDeg":0,"spectrum":"D65"},)"
+                         R"({"name":"back","direction":[1,0,0.2],"angularSizeDeg":0,"spectrum":"A"}])", "test");
   return img;
 }
 
@@ -57,7 +57,7 @@ SpectralImage one_bin(int width, int height) {
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) layer.data.push_back(static_cast<float>(1.2 * (x + 0.5) / width * (0.3 + 0.7 * y / height)));
   img.lights.push_back(std::move(layer));
-  img.info.lights_json = R"([{"name":"key","direction":[0,0,1],"angularSizeDeg":0,"spectrum":"D65"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"key","direction":[0,0,1],"angularSizeDeg":0,"spectrum":"D65"}])", "test");
   return img;
 }
 

@@ -54,8 +54,8 @@ int write_colorchecker(const std::filesystem::path& path) {
         img.lights[1].data[k] = static_cast<float>(r * back);
       }
     }
-  img.info.lights_json = R"([{"name":"key","direction":[-1,0,1],"angularSizeDeg":0,"spectrum":"D65"},)"
-                         R"({"name":"back","direction":[1,0,0.2],"angularSizeDeg":0,"spectrum":"off"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"key","direction":[-1,0,1],"angularSizeDeg":0,"spectrum":"D65"},)"
+                         R"({"name":"back","direction":[1,0,0.2],"angularSizeDeg":0,"spectrum":"off"}])", "test");
   write_spectral_exr(path, img);
   return 0;
 }
@@ -91,8 +91,8 @@ int main(int argc, char** argv) {
         if (x < 8) img.lights[0].data[k] = 0.5f;
         else img.lights[1].data[k] = static_cast<float>(0.1 + 0.8 * std::exp(-0.5 * std::pow((img.bins.centre_nm(i) - 540.0) / 40.0, 2)));
       }
-  img.info.lights_json = R"([{"name":"key","direction":[0,0,1],"angularSizeDeg":0,"spectrum":"D65"},)"
-                         R"({"name":"back","direction":[0,1,0],"angularSizeDeg":0,"spectrum":"A"}])";
+  img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"key","direction":[0,0,1],"angularSizeDeg":0,"spectrum":"D65"},)"
+                         R"({"name":"back","direction":[0,1,0],"angularSizeDeg":0,"spectrum":"A"}])", "test");
   write_spectral_exr(dir / "scene.exr", img);
 
   std::ofstream(dir / "batch.json") << R"({

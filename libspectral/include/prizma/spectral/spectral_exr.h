@@ -8,11 +8,14 @@
 #include <vector>
 
 #include "prizma/spectral/bin_layout.h"
+#include "prizma/spectral/light_record.h"
 
 namespace prizma::spectral {
 
 struct SpectralExrInfo {
-  std::string lights_json;       // prizma:lights (JSON array of {name, direction, angularSizeDeg, spectrum})
+  // prizma:lights, one record per light (light_record.h). Written as given; when empty, records that
+  // name the layers. Read: refused unless they describe the file's layers (check_light_records).
+  std::vector<LightRecord> light_records;
   std::int64_t samples = 0;      // prizma:samples, samples per pixel in this file
   std::string sample_range;      // prizma:sampleRange "A:B"
   std::int64_t seed = 0;         // prizma:seed

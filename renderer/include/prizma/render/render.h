@@ -64,10 +64,11 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
 spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards,
                                      const std::vector<std::string>& names = {});
 
-// The scene's lights in the JSON form stored in prizma:lights.
-std::string lights_to_json(const std::vector<Light>& lights);
+// The scene's lights as the records stored in prizma:lights.
+std::vector<spectral::LightRecord> light_records(const std::vector<Light>& lights);
 // Lights back from an image's prizma:lights (names, directions, default spectra); lights missing
-// from the JSON (foreign files) get the layer name, the environment direction and "D65".
+// from the records (foreign files) get the layer name, the environment direction and the default
+// spectrum (spectral::default_spectrum).
 std::vector<Light> lights_from_image(const spectral::SpectralImage& image);
 
 struct PreviewOptions {
