@@ -2,7 +2,7 @@
 # headless Chromium against prizma-relight -o and against pages of other origins (label "browser";
 # skipped, exit 77, when chromium, chromium-driver or python3-selenium are missing, failed then with
 # CI=true: tests/missing-tool). Driver: browser/live_page_test.py. The page's state handling
-# (relight/web/state.js) under node's test runner (Debian's nodejs): relight.live.page_state.
+# (relight/serve/web/state.js) under node's test runner (Debian's nodejs): relight.live.page_state.
 if(NOT TARGET prizma-relight)
   return()
 endif()

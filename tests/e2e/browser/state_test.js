@@ -1,4 +1,4 @@
-// The live page's state handling (relight/web/state.js) under node's test runner: the URL fragment
+// The live page's state handling (relight/serve/web/state.js) under node's test runner: the URL fragment
 // ⇄ the controls' values, and the run's secret kept out of every state the page writes.
 // ctest relight.live.page_state: node --test tests/e2e/browser/state_test.js
 'use strict';
@@ -6,7 +6,7 @@ const test = require('node:test');
 const assert = require('node:assert/strict');
 const path = require('node:path');
 
-const S = require(path.join(__dirname, '..', '..', '..', 'relight', 'web', 'state.js'));
+const S = require(path.join(__dirname, '..', '..', '..', 'relight', 'serve', 'web', 'state.js'));
 
 const kToken = '3f0c9e2d8a7b41c6a05d1e9f7c2b8a64';
 const kStart = 'light.side=D65&light.back=A*0.5&exposure=0&cmf=1931&display=sRGB&adapt=0';
