@@ -66,10 +66,11 @@ prizma_build_installed() {
   echo "  built: $build/renderer/prizma-render, $build/relight/prizma-relight, $build/libspectral/prizma-metamer" >&2
 }
 
-# prizma_install BUILD PREFIX: cmake --install, quietly; lists where things went.
+# prizma_install BUILD PREFIX: cmake --install, quietly, stripped (the build folder keeps the debug
+# information: gdb and perf on build/'s binaries); lists where things went.
 prizma_install() {
   local build="$1" prefix="$2"
-  if ! cmake --install "$build" --prefix "$prefix" >"$build/install.log" 2>&1; then
+  if ! cmake --install "$build" --prefix "$prefix" --strip >"$build/install.log" 2>&1; then
     echo "prizma: the install into $prefix failed:" >&2
     tail -n 20 "$build/install.log" >&2
     exit 1
@@ -78,7 +79,8 @@ prizma_install() {
        "data in share/prizma (scenes in share/prizma/scenes), docs in share/doc/prizma" >&2
 }
 
-# How to run the installed tools: PATH advice when PREFIX/bin is not on it.
+# How to run the installed tools and import the Python module: PATH and PYTHONPATH advice when
+# PREFIX/bin is not on PATH, or the module's folder is not one /usr/bin/python3 reads.
 prizma_path_advice() {
   local prefix="$1"
   case ":$PATH:" in
@@ -87,4 +89,15 @@ prizma_path_advice() {
        echo "  export PATH=\"$prefix/bin:\$PATH\""
        echo "then: prizma-render --help, prizma-relight --help, prizma-metamer --help" ;;
   esac
+  local module pydir
+  module=$(find "$prefix/lib" -path '*/prizma/__init__.py' 2>/dev/null | head -n 1)
+  [[ -n "$module" ]] || return 0
+  pydir=$(dirname "$(dirname "$module")")
+  if /usr/bin/python3 -c 'import sys; sys.exit(0 if sys.argv[1] in sys.path else 1)' "$pydir" 2>/dev/null; then
+    echo "The Python module: /usr/bin/python3 -c 'import prizma' (from $pydir)"
+  else
+    echo "For the Python module (docs/python.md), also:"
+    echo "  export PYTHONPATH=\"$pydir\${PYTHONPATH:+:\$PYTHONPATH}\""
+    echo "then: /usr/bin/python3 -c 'import prizma; print(prizma.version())'"
+  fi
 }
