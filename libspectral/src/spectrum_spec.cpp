@@ -150,6 +150,14 @@ std::string known_list() {
   return out + kForms;
 }
 
+// The one sign rule of spec values (constants and csv: rows): the quantity decides. A negative value
+// of a quantity that is ≥ 0 is refused: "<what> must not be negative, got <shown>".
+void check_sign(double v, SpectrumValues values, const std::string& input, std::string_view what,
+                const std::string& shown) {
+  if (values == SpectrumValues::NonNegative && v < 0.0)
+    throw InputError(input, std::string(what) + " must not be negative, got " + shown);
+}
+
 // A finite number from `tok`, or an InputError naming `what`.
 double number(std::string_view tok, const char* what, const SpecContext& ctx, std::string_view spec) {
   double v = 0.0;
@@ -256,7 +264,7 @@ Spectrum parse_unscaled(std::string_view s, const SpecContext& ctx) {
   double v = 0.0;
   if (detail::parse_double(s, v)) {
     if (!std::isfinite(v)) throw InputError(ctx.input, "constant spectrum is not a finite number: " + dquote(s));
-    if (v < 0.0) throw InputError(ctx.input, "constant spectrum must not be negative, got " + dquote(s));
+    check_sign(v, ctx.values, ctx.input, "constant spectrum", dquote(s));
     return Spectrum::constant(v);
   }
   const auto colon = s.find(':');
@@ -271,7 +279,7 @@ Spectrum parse_unscaled(std::string_view s, const SpecContext& ctx) {
       const std::filesystem::path rel(std::string(detail::trim(arg)));
       if (rel.empty()) throw InputError(ctx.input, "csv: needs a file path");
       const auto path = (rel.is_relative() && !ctx.base_dir.empty()) ? ctx.base_dir / rel : rel;
-      return read_spectrum_csv(path);
+      return read_spectrum_csv(path, ctx.values);
     }
     throw InputError(ctx.input, "unknown spectrum " + dquote(s) + " (known: " + known_list() + ")");
   }
@@ -315,7 +323,7 @@ std::vector<std::string> colorchecker_patches() {
   return out;
 }
 
-Spectrum read_spectrum_csv(const std::filesystem::path& path) {
+Spectrum read_spectrum_csv(const std::filesystem::path& path, SpectrumValues values) {
   const auto t = detail::read_csv_table(path, 2, 2);
   detail::check_increasing_wavelengths(t, path);
   std::vector<double> lam, val;
@@ -324,9 +332,7 @@ Spectrum read_spectrum_csv(const std::filesystem::path& path) {
     if (t.rows[r][0] <= 0.0) {
       throw InputError(where, "wavelength must be positive, got " + format_double(t.rows[r][0]));
     }
-    if (t.rows[r][1] < 0.0) {
-      throw InputError(where, "value must not be negative, got " + format_double(t.rows[r][1]));
-    }
+    check_sign(t.rows[r][1], values, where, "value", format_double(t.rows[r][1]));
     lam.push_back(t.rows[r][0]);
     val.push_back(t.rows[r][1]);
   }

@@ -38,6 +38,20 @@ FluorescenceLayout fluorescence_layout(const Medium& medium, const spectral::Bin
 
 namespace prizma::render {
 
+void PathResult::close_fluorescent_segment(float lambda_in_nm) {
+  const bool saw = fl_environment[0] != 0.0f || fl_emission[0] != 0.0f ||
+                   std::any_of(fl_directional.begin(), fl_directional.end(), [](float v) { return v != 0.0f; });
+  if (saw) {
+    fl_segments.push_back(lambda_in_nm);
+    fl_segments.push_back(fl_environment[0]);
+    fl_segments.push_back(fl_emission[0]);
+    fl_segments.insert(fl_segments.end(), fl_directional.begin(), fl_directional.end());
+  }
+  fl_environment[0] = 0.0f;
+  fl_emission[0] = 0.0f;
+  std::fill(fl_directional.begin(), fl_directional.end(), 0.0f);
+}
+
 ExcitationSampler::ExcitationSampler(const spectral::Spectrum& sigma_f, double lo_nm, double hi_nm)
     : m_sigma_f(&sigma_f) {
   if (!(hi_nm > lo_nm)) return;

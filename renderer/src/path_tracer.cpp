@@ -778,9 +778,12 @@ void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch&
   if (n == 1) {
     // One wavelength per path (--wavelength-sampling single): the path's wavelength becomes λin,
     // drawn with density σf(λ)·λ/Λ (ExcitationSampler; Φ holds Λ), its weight that draw's. The out
-    // side keeps the event's factor a = w·d·Φ·c/(μ̄·mf); the bin of λin is read off the wavelength.
+    // side keeps the first event's factor a = w·d·Φ·c/(μ̄·mf); a later event's factor scales the in
+    // side. The in bin is read off the wavelength, so a later event first closes the segment seen at
+    // the previous λin (PathResult::fl_segments): left open, it would be counted in the new λin's bin.
     float& w0 = s.work.weight[0];
     const float event = w0 * density * cache.fl_out[static_cast<std::size_t>(m)] * k;
+    if (out.fl_active) out.close_fluorescent_segment(cache.lambda_nm[0]);
     const ExcitationSampler::Draw draw = m_fl_excitation[m].sample(rng.uniform_double());
     cache.lambda_nm[0] = static_cast<float>(draw.lambda_nm);
     cache.new_wavelengths();  // every material is evaluated anew at the new wavelength
@@ -789,6 +792,7 @@ void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch&
       std::fill(out.fl_environment.begin(), out.fl_environment.end(), 0.0f);
       std::fill(out.fl_emission.begin(), out.fl_emission.end(), 0.0f);
       std::fill(out.fl_directional.begin(), out.fl_directional.end(), 0.0f);
+      out.fl_segments.clear();
       out.fl_active = true;
       w0 = static_cast<float>(draw.weight);
     } else {

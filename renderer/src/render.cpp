@@ -161,19 +161,15 @@ class PixelRenderer {
     const float* a = ps.out.fl_a.data();
     if (m_c.map.mode() == LaneMode::Single) {
       // One lane: out = the camera bin (drawn with probability 1/n: weight n), in = the bin of the
-      // path's last wavelength (σf > 0 there, so the pair is in the layout).
-      const double lambda_in = ps.cache.lambda_nm[0];
-      const int in = m_c.settings.bins.find(lambda_in);
-      const int k = in < 0 ? -1 : in == bin ? -2 : m_c.pair_index[static_cast<std::size_t>(bin) * nb + in];
-      for (int l = 0; l < nl; ++l) {
-        const double val = static_cast<double>(a[0]) * lane_values(ps.out, l, true)[0] * nb * m_fold.at(l, lambda_in);
-        ok = ok && std::isfinite(val);
-        if (k == -2 || (k >= 0 && Fold::kFolds))
-          v[static_cast<std::size_t>(l) * nb + bin] += val;
-        else if (k >= 0)
-          vf[static_cast<std::size_t>(l) * np + static_cast<std::size_t>(k)] = val;
-      }
-      return ok;
+      // wavelength each segment carried (σf > 0 there, so the pair is in the layout): the segments
+      // that later events closed, then the open one, at the path's last wavelength.
+      const std::size_t size = PathResult::fl_segment_size(m_c.tracer.directional_lights().size());
+      const std::vector<float>& seg = ps.out.fl_segments;
+      for (std::size_t r = 0; r + size <= seg.size(); r += size)
+        ok = add_single_segment(seg[r + PathResult::kSegmentLambda], a[0], bin,
+                                [&](int l) { return seg[r + segment_offset(l)]; }, v, vf) && ok;
+      return add_single_segment(ps.cache.lambda_nm[0], a[0], bin,
+                                [&](int l) { return lane_values(ps.out, l, true)[0]; }, v, vf) && ok;
     }
     for (int l = 0; l < nl; ++l) {
       const float* src = lane_values(ps.out, l, true);
@@ -197,6 +193,35 @@ class PixelRenderer {
       }
     }
     return ok;
+  }
+
+  // Single mode: one segment's term a·(in side at λin)·n into the pair (camera bin, bin of λin), per
+  // light l (in_side(l)); added to the pair's value of the sample (a path can visit a bin twice).
+  template <class InSide>
+  bool add_single_segment(double lambda_in, float a, int bin, const InSide& in_side, double* v, double* vf) const {
+    const int nl = static_cast<int>(m_c.source.size());
+    const int nb = m_c.settings.bins.size();
+    const std::size_t np = m_c.fluor.pairs.size();
+    const int in = m_c.settings.bins.find(lambda_in);
+    const int k = in < 0 ? -1 : in == bin ? -2 : m_c.pair_index[static_cast<std::size_t>(bin) * nb + in];
+    bool ok = true;
+    for (int l = 0; l < nl; ++l) {
+      const double val = static_cast<double>(a) * in_side(l) * nb * m_fold.at(l, lambda_in);
+      ok = ok && std::isfinite(val);
+      if (k == -2 || (k >= 0 && Fold::kFolds))
+        v[static_cast<std::size_t>(l) * nb + bin] += val;
+      else if (k >= 0)
+        vf[static_cast<std::size_t>(l) * np + static_cast<std::size_t>(k)] += val;
+    }
+    return ok;
+  }
+
+  // Light l's place in a closed segment's record (PathResult::fl_segments).
+  std::size_t segment_offset(int l) const {
+    const int src = m_c.source[l];
+    if (src == -2) return PathResult::kSegmentEmission;
+    if (src < 0) return PathResult::kSegmentEnvironment;
+    return PathResult::kSegmentDirectional + static_cast<std::size_t>(src);
   }
 
   const RenderContext& m_c;

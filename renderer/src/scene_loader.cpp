@@ -137,13 +137,17 @@ class Reader {
     return p.is_absolute() ? p : m_base / p;
   }
 
-  // A spectrum: a spec string, a number, or {"spectrum": SPEC, "scale": number}.
-  Spectrum spectrum(const json& j, const std::string& path) const {
+  // A spectrum: a spec string, a number, or {"spectrum": SPEC, "scale": number}, of a quantity with
+  // the sign `values` (spectrum_spec.h: only the anisotropy is signed). A number is checked by the
+  // field's own range (validate_material, …).
+  Spectrum spectrum(const json& j, const std::string& path,
+                    spectral::SpectrumValues values = spectral::SpectrumValues::NonNegative) const {
     if (j.is_number()) return Spectrum::constant(number(j, path));
     if (j.is_string()) {
       spectral::SpecContext ctx;
       ctx.input = input(path);
       ctx.base_dir = m_base;
+      ctx.values = values;
       return spectral::parse_spectrum(j.get<std::string>(), ctx);
     }
     if (j.is_object()) {
@@ -153,7 +157,7 @@ class Reader {
       if (!inner.is_string() && !inner.is_number()) {
         fail(join(path, "spectrum"), "must be a spectrum spec string or a number (got " + describe(inner) + ")");
       }
-      Spectrum s = spectrum(inner, join(path, "spectrum"));
+      Spectrum s = spectrum(inner, join(path, "spectrum"), values);
       if (j.contains("scale")) s = s.scaled(positive(j.at("scale"), join(path, "scale")));
       return s;
     }
@@ -406,7 +410,8 @@ TransferFunction read_materials(const Reader& rd, const json& j, const ValueNorm
     if (!mj.contains("extinction")) rd.fail(ep, "is required");
     m.albedo = rd.spectrum(mj.at("albedo"), ap);
     m.sigma_t_per_unit = rd.spectrum(mj.at("extinction"), ep);
-    m.anisotropy = mj.contains("anisotropy") ? rd.spectrum(mj.at("anisotropy"), Reader::join(mp, "anisotropy"))
+    m.anisotropy = mj.contains("anisotropy") ? rd.spectrum(mj.at("anisotropy"), Reader::join(mp, "anisotropy"),
+                                                           spectral::SpectrumValues::Signed)
                                              : Spectrum::constant(0.0);
     validate_material(m, rd.input(mp));
     if (mj.contains("emission")) {

@@ -27,6 +27,13 @@ prizma_render_e2e(merge_overlap "merge|shard0.exr|shard0.exr|-o|overlap.exr" EXP
 prizma_render_e2e(resume "${_tiny}|--resume|shard0.exr|--spp|4|-o|resumed.exr|-q" MUST_EXIST resumed.exr
   FIXTURES_REQUIRED render_shards)
 
+# A material's anisotropy is signed: a csv: table of g with negative values renders; the same table
+# as an albedo is refused, naming the file and line (issue 27; docs/spectra.md, "Signed quantities").
+prizma_render_e2e(signed_anisotropy_table "${_tiny}|-D|materials.haze.anisotropy=csv:backscatter_g.csv|-o|backscatter.exr|-q"
+  MUST_EXIST backscatter.exr)
+prizma_render_e2e(negative_albedo_table "${_tiny}|-D|materials.haze.albedo=csv:backscatter_g.csv|-o|bad.exr" EXPECT_RC 2
+  MUST_NOT_EXIST bad.exr ERR_REGEX "backscatter_g\\.csv:3: value must not be negative, got -0\\.6" ERR_LINES 1)
+
 # Failures: usage errors exit 2 with "prizma-render: error: ..." and write nothing.
 prizma_render_e2e(bad_option "${_tiny}|--bogus|-o|bad.exr" EXPECT_RC 2 MUST_NOT_EXIST bad.exr
   ERR_REGEX "prizma-render: error:")

@@ -8,7 +8,9 @@
 
 #include "prizma/render/phase.h"
 #include "prizma/render/render.h"
+#include "prizma/spectral/spectrum_spec.h"
 #include "render_test_scenes.h"
+#include "test_scene_util.h"
 #include "transfer_references.h"
 
 namespace prizma::render {
@@ -29,6 +31,24 @@ TEST(RenderDirectional, HFunctionSolvesChandrasekharsEquation) {
       EXPECT_NEAR(h(mu), 1.0 + 0.5 * w * mu * h(mu) * integral, 1e-8) << "albedo " << w << " mu " << mu;
     }
   }
+}
+
+TEST(RenderDirectional, HalfSpaceReflectionSolvesTheIsotropicCaseAndTheSingleScatteringLimit) {
+  // Self-checks of the Ambartsumian solution: with isotropic scattering it is Chandrasekhar's
+  // ω μ0 H(1) H(μ0) / (4π (1 + μ0)); at a small albedo, multiple scattering is O(ω²) and what is
+  // left is single scattering of the half-space, ω p(−μ0) μ0 / (1 + μ0) (Henyey–Greenstein, g < 0,
+  // so the sign convention of the phase function's argument is checked too).
+  for (double w : {0.5, 0.9}) {
+    const HFunction h(w);
+    for (double mu0 : {1.0, 0.5}) {
+      const double want = w * mu0 * h(1.0) * h(mu0) / (4.0 * kPi * (1.0 + mu0));
+      EXPECT_NEAR(HalfSpaceReflection(w, [](double) { return 1.0 / (4.0 * kPi); }, mu0).radiance(), want, 1e-6 * want)
+          << "albedo " << w << " mu0 " << mu0;
+    }
+  }
+  const double w = 1e-4, mu0 = 0.5, g = -0.6;
+  const double single = w * hg(-mu0, g) * mu0 / (1.0 + mu0);
+  EXPECT_NEAR(HalfSpaceReflection(w, [g](double c) { return hg(c, g); }, mu0).radiance(), single, 1e-3 * single);
 }
 
 TEST(RenderDirectional, SingleScatteringFromASlabMatchesTheClosedForm) {
@@ -103,6 +123,39 @@ TEST(RenderDirectional, IsotropicHalfSpaceMatchesChandrasekharsHFunction) {
       }
     }
   }
+}
+
+TEST(RenderDirectional, SignedAnisotropyTableMatchesTheHalfSpaceReflection) {
+  // A per-bin Henyey–Greenstein g from −0.7 to 0.3, read from a csv: table with negative values (as
+  // a scene's "anisotropy": "csv:g.csv" is, spectrum_spec.h: SpectrumValues::Signed), over the
+  // half-space of IsotropicHalfSpaceMatchesChandrasekharsHFunction (albedo 0.9, σt = 400, light at
+  // 60°), all orders of scattering: per bin the Ambartsumian solution with that bin's g. The table
+  // steps between bins over 0.001 nm (2·10⁻⁵ of a bin, far below the noise).
+  const std::vector<double> g = {-0.7, -0.5, -0.3, -0.1, 0.1, 0.3};
+  std::string csv = "wavelength_nm,g\n";
+  for (int b = 0; b < 6; ++b)
+    csv += std::to_string(400 + 50 * b) + "," + std::to_string(g[b]) + "\n" + std::to_string(b == 5 ? 700.0 : 449.999 + 50 * b) + "," +
+           std::to_string(g[b]) + "\n";
+  const ScratchDir dir;
+  spectral::SpecContext ctx;
+  ctx.values = spectral::SpectrumValues::Signed;
+  const Spectrum table = spectral::parse_spectrum("csv:" + dir.write("g.csv", csv).string(), ctx);
+  ASSERT_DOUBLE_EQ(table.eval(425.0), -0.7);
+  const double w = 0.9, theta0 = 60.0 * kPi / 180.0, mu0 = std::cos(theta0);
+  Scene s = window_scene(make_material(Spectrum::constant(w), Spectrum::constant(400.0), table),
+                         testing::directional_light("sun", {std::sin(theta0), 0.0, mu0}), 16, 128);
+  s.settings.seed = 14;
+  const auto e = pixel_average(render(s), 0);
+  for (int b = 0; b < 6; ++b) {
+    const double gb = g[b];
+    const double expected = HalfSpaceReflection(w, [gb](double c) { return hg(c, gb); }, mu0).radiance();
+    EXPECT_NEAR(e.mean[b], expected, kSe * e.se[b]) << "g " << gb << " bin " << b << ": " << e.mean[b] << " ± " << e.se[b];
+    EXPECT_LT(e.se[b], 0.02 * expected);
+  }
+  // The test tells g from −g: the reflection differs by far more than the noise.
+  EXPECT_GT(std::abs(HalfSpaceReflection(w, [](double c) { return hg(c, -0.7); }, mu0).radiance() -
+                     HalfSpaceReflection(w, [](double c) { return hg(c, 0.7); }, mu0).radiance()),
+            10.0 * e.se[0]);
 }
 
 }  // namespace

@@ -309,6 +309,34 @@ TEST(SceneLoaderErrors, OutOfRangeMaterialValues) {
   expect_error(dir, j, "materials", "at least one");
 }
 
+// Anisotropy is signed, so a csv: table of g may hold negative values (backward scattering); the
+// other material spectra may not (issue 27).
+TEST(SceneLoader, AnisotropyTableMayBeNegativeOtherSpectraMayNot) {
+  ScratchDir dir;
+  const auto table = dir.write("g.csv", "wavelength_nm,g\n400,-0.6\n550,-0.2\n700,0.3\n");
+  json j = base_scene();
+  j["materials"][0]["anisotropy"] = "csv:g.csv";
+  j["materials"][1]["anisotropy"] = {{"spectrum", "csv:g.csv"}, {"scale", 0.5}};
+  const Scene s = load_scene(write_scene(dir, j));
+  EXPECT_DOUBLE_EQ(s.medium.materials[0].anisotropy.eval(400.0), -0.6);
+  EXPECT_DOUBLE_EQ(s.medium.materials[1].anisotropy.eval(400.0), -0.3);
+  j["materials"][0]["anisotropy"] = "-0.4";
+  EXPECT_DOUBLE_EQ(load_scene(write_scene(dir, j)).medium.materials[0].anisotropy.eval(500.0), -0.4);
+  j["materials"][0]["anisotropy"] = "csv:g.csv*2";  // −1.2: signed, but outside (−1, 1)
+  expect_error(dir, j, "materials[0].anisotropy", "(-1, 1)");
+  for (const char* field : {"albedo", "extinction", "emission"}) {
+    j = base_scene();
+    j["materials"][0][field] = "csv:g.csv";
+    const auto path = write_scene(dir, j);
+    try {
+      load_scene(path);
+      ADD_FAILURE() << field << ": a negative table loaded";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), table.string() + ":2: value must not be negative, got -0.6") << field;
+    }
+  }
+}
+
 TEST(SceneLoaderErrors, BadSpectrumSpecsNameTheField) {
   ScratchDir dir;
   json j = base_scene();

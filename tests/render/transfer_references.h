@@ -87,4 +87,80 @@ class HFunction {
   std::vector<double> m_x, m_q, m_h;
 };
 
+// Diffuse reflection of a semi-infinite medium of albedo ω and any phase function p(cos Θ) (per
+// steradian, normalised over the sphere), seen straight down (μ = 1) under a delta light of unit
+// irradiance at μ0: I(1; μ0) = S(1, μ0)/(4π), where S is the azimuth average of Chandrasekhar's
+// scattering function (Radiative Transfer, 1950, ch. IV, §27: the principle of invariance). At μ = 1
+// the azimuth drops out, so S's m = 0 term is the whole answer, and it solves Ambartsumian's
+// nonlinear equation, on its own for m = 0 (the azimuthal terms decouple):
+//   (1/μ + 1/ν) S(μ, ν) = P−(μ, ν) + ½ ∫₀¹ S(μ, x) P+(x, ν) dx/x + ½ ∫₀¹ P+(μ, x) S(x, ν) dx/x
+//                         + ¼ ∫₀¹∫₀¹ S(μ, x) P−(x, y) S(y, ν) dx/x dy/y,
+// P±(a, b) = (1/2π) ∫₀^{2π} 4πω p(±ab + √(1−a²)√(1−b²) cos φ) dφ (the phase function between two
+// upward directions, +, or an upward and a downward one, −). Solved by fixed-point iteration from 0
+// (the orders of scattering) on 48 Gauss–Legendre nodes in μ, plus μ = 1 and μ0 as points of
+// zero weight (Nyström), the azimuth by 48 nodes. Isotropic p gives ω μ ν H(μ) H(ν)/(μ + ν), checked
+// against HFunction in test_render_directional.cpp.
+class HalfSpaceReflection {
+ public:
+  HalfSpaceReflection(double albedo, const std::function<double(double)>& phase, double mu0) {
+    gauss_legendre(kNodes, 0.0, 1.0, m_x, m_c);
+    for (std::size_t i = 0; i < m_x.size(); ++i) m_c[i] /= m_x[i];  // the weights of dx/x
+    m_x.push_back(1.0);
+    m_x.push_back(mu0);
+    m_c.push_back(0.0);
+    m_c.push_back(0.0);
+    const std::size_t n = m_x.size();
+    std::vector<double> phi, wphi;
+    gauss_legendre(kNodes, 0.0, std::numbers::pi, phi, wphi);  // p is even in φ: [0, π] is half the circle
+    std::vector<double> plus(n * n), minus(n * n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = 0; j < n; ++j) {
+        const double a = m_x[i], b = m_x[j], s = std::sqrt(std::max(0.0, (1.0 - a * a) * (1.0 - b * b)));
+        double p = 0.0, m = 0.0;
+        for (std::size_t k = 0; k < phi.size(); ++k) {
+          p += wphi[k] * phase(std::clamp(a * b + s * std::cos(phi[k]), -1.0, 1.0));
+          m += wphi[k] * phase(std::clamp(-a * b + s * std::cos(phi[k]), -1.0, 1.0));
+        }
+        plus[i * n + j] = 4.0 * albedo * p;  // 4πω · (1/π) ∫₀^π
+        minus[i * n + j] = 4.0 * albedo * m;
+      }
+    m_s.assign(n * n, 0.0);
+    std::vector<double> sc(n * n), cs(n * n), next(n * n);
+    for (int it = 0; it < 5000; ++it) {
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j) {
+          sc[i * n + j] = m_s[i * n + j] * m_c[j];  // S·C
+          cs[i * n + j] = m_c[i] * m_s[i * n + j];  // C·S
+        }
+      const std::vector<double> a = product(sc, plus, n), b = product(plus, cs, n);
+      const std::vector<double> c = product(product(sc, minus, n), cs, n);
+      double change = 0.0;
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j) {
+          const std::size_t k = i * n + j;
+          next[k] = (minus[k] + 0.5 * a[k] + 0.5 * b[k] + 0.25 * c[k]) / (1.0 / m_x[i] + 1.0 / m_x[j]);
+          change = std::max(change, std::abs(next[k] - m_s[k]));
+        }
+      m_s.swap(next);
+      if (change < 1e-14) break;
+    }
+  }
+  // The radiance seen straight down, S(1, μ0)/(4π).
+  double radiance() const {
+    const std::size_t n = m_x.size();
+    return m_s[(n - 2) * n + (n - 1)] / (4.0 * std::numbers::pi);
+  }
+
+ private:
+  static constexpr int kNodes = 48;
+  static std::vector<double> product(const std::vector<double>& a, const std::vector<double>& b, std::size_t n) {
+    std::vector<double> c(n * n, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < n; ++k)
+        for (std::size_t j = 0; j < n; ++j) c[i * n + j] += a[i * n + k] * b[k * n + j];
+    return c;
+  }
+  std::vector<double> m_x, m_c, m_s;  // nodes (then 1 and μ0), weights of dx/x, S at the nodes
+};
+
 }  // namespace prizma::render::testing

@@ -234,6 +234,29 @@ TEST_F(SpecFiles, CsvRelativeToBaseDir) {
   EXPECT_THROW((void)parse_spectrum("csv:nope.csv", missing), InputError);
 }
 
+// The quantity decides the sign (SpecContext::values): a signed one (the anisotropy g) takes negative
+// constants and csv: rows, every other quantity refuses them, named by file and line as before.
+TEST_F(SpecFiles, SignedQuantitiesTakeNegativeValuesOthersRefuseThem) {
+  const fs::path p = write("g.csv", "wavelength_nm,g\n400,-0.6\n700,0.2\n");
+  SpecContext signed_ctx;
+  signed_ctx.values = SpectrumValues::Signed;
+  const Spectrum g = parse_spectrum("csv:" + p.string(), signed_ctx);
+  EXPECT_EQ(g.values(), (std::vector<double>{-0.6, 0.2}));
+  EXPECT_EQ(read_spectrum_csv(p, SpectrumValues::Signed).values(), g.values());
+  EXPECT_DOUBLE_EQ(parse_spectrum("-0.3", signed_ctx).eval(500), -0.3);
+  EXPECT_DOUBLE_EQ(parse_spectrum("csv:" + p.string() + "*0.5", signed_ctx).eval(400), -0.3);
+  SpecContext albedo;
+  albedo.input = "scene.json: materials[0].albedo";
+  try {
+    (void)parse_spectrum("csv:" + p.string(), albedo);
+    ADD_FAILURE() << "a negative csv: value of a non-negative quantity parsed";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), p.string() + ":2: value must not be negative, got -0.6");
+  }
+  expect_spec_error("-0.3", "constant spectrum must not be negative, got \"-0.3\"");
+  expect_csv_error("neg.csv", "400,0.5\n700,-0.1\n", "neg.csv:2: value must not be negative, got -0.1");
+}
+
 TEST_F(SpecFiles, CsvBadLinesNameFileAndLine) {
   expect_csv_error("a.csv", "wavelength_nm,value\n400,1\n450,abc\n", "a.csv:3: not a number: \"abc\"");
   expect_csv_error("b.csv", "400,1\n500,2\n450,3\n", "b.csv:3: wavelengths must be strictly increasing: 450 nm follows 500");

@@ -93,6 +93,18 @@ struct PathResult {
   std::vector<float> fl_environment;  // [lanes] in side, per light as the diagonal results
   std::vector<float> fl_directional;  // [directional light][lanes]
   std::vector<float> fl_emission;     // [lanes]
+  // One lane (--wavelength-sampling single) only: the in side of the segments that a later event
+  // closed. A one-lane path's bin on the in side is that of its current wavelength λin, which every
+  // event draws anew, so what it saw between two events belongs to the earlier λin: the later event
+  // moves it here as one record of fl_segment_size(lights) floats, {λin, environment, emission,
+  // directional[0..lights)}, and fl_<light> restart at zero (docs/fluorescence.md).
+  std::vector<float> fl_segments;
+  static constexpr std::size_t kSegmentLambda = 0, kSegmentEnvironment = 1, kSegmentEmission = 2,
+                               kSegmentDirectional = 3;
+  static std::size_t fl_segment_size(std::size_t directional_lights) { return kSegmentDirectional + directional_lights; }
+  // One lane: closes the segment seen at lambda_in_nm (a record in fl_segments, none when it saw
+  // nothing) and restarts fl_<light> at zero (renderer/src/fluorescence.cpp).
+  void close_fluorescent_segment(float lambda_in_nm);
 };
 
 struct PathScratch {
