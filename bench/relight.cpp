@@ -1,11 +1,14 @@
 // Relight throughput: XYZ = Σ_l M_l·T_l over a 1024×1024 image with 32 bins and 2 light layers,
-// against a plain streaming read (a sum) of the same transport buffers, interleaved in the same run.
-// Counters: relight_GBps and sum_GBps (transport bytes read per second) and ratio = relight time /
-// sum time (target ≤ 1.3: the relight is memory-bandwidth bound). Arg: threads (0 = all). The
-// variants force one SIMD target of the kernel's run-time dispatch (relight_simd.cpp): "best" is
-// what the tools use on this CPU; AVX2 and SSE4 (128-bit, the width of the former SSE2 build) are
-// for comparison inside the same run.
-// Also: the share of a spectral EXR read spent verifying its pixel checksum (BM_ReadVsChecksum).
+// against a plain streaming read (a sum) of the same transport buffers, interleaved in the same run:
+// every iteration times the sum, then the relight at every SIMD level of the kernel
+// (relight_simd.h), the level the tools dispatch to among them (bench_levels.h).
+// Counters: sum_ms, ratio = dispatched relight time / sum time (target ≤ 1.3: the relight is
+// memory-bandwidth bound), ratio_L per level L, relight_GBps and sum_GBps (transport bytes read per
+// second, dispatched level), and bench_levels.h's ms_L, dispatched_ms, best_ms, dispatched_over_best,
+// dispatch_slower; medians over the iterations. Arg: threads (0 = all).
+// Also: the fluorescent row pass at every level (BM_FluorescentRelightLevels), fluorescent against
+// plain relighting (BM_FluorescentVsPlainRelight), and the share of a spectral EXR read spent
+// verifying its pixel checksum (BM_ReadVsChecksum).
 #include <benchmark/benchmark.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -20,6 +23,7 @@
 #include <string>
 
 #include "bench_image.h"
+#include "bench_levels.h"
 #include "prizma/relight/relight_image.h"
 #include "prizma/relight/relight_matrix.h"
 #include "prizma/relight/relight_simd.h"
@@ -57,46 +61,59 @@ double streaming_sum(const spectral::SpectralImage& img) {
       [](double a, double b) { return a + b; });
 }
 
-void BM_RelightVsStreamingSum(benchmark::State& state, const std::string& target) {
-  relight::detail::relight_simd_force_target(target);
-  state.SetLabel(relight::detail::relight_simd_target());
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The median of `v` (not empty).
+double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+void BM_RelightVsStreamingSum(benchmark::State& state) {
   const auto limit = bench::limit_threads(state.range(0));
+  const double load_start = bench::load_average();
   const spectral::SpectralImage& img = bench_image();
   std::vector<relight::LightSpec> lights = {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")};
   const relight::RelightMatrix matrix(img.bins, lights, {});
   std::vector<float> xyz(3 * img.pixel_count());
   const double bytes = static_cast<double>(img.lights.size() * img.pixel_count() * kBins * sizeof(float));
-  double relight_s = 0.0, sum_s = 0.0;
+  const spectral::SimdLevel dispatched = relight::detail::relight_simd_level();
+  bench::LevelTimes times(relight::detail::relight_simd_levels());
+  std::vector<double> sum_s;
   for (auto _ : state) {
-    // Interleaved so that both see the same machine load.
-    auto t0 = std::chrono::steady_clock::now();
+    // Interleaved so that all see the same machine load.
+    const auto t0 = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(streaming_sum(img));
-    auto t1 = std::chrono::steady_clock::now();
-    relight::relight_into(img, matrix, xyz.data());
-    benchmark::ClobberMemory();
-    auto t2 = std::chrono::steady_clock::now();
-    const double s = std::chrono::duration<double>(t1 - t0).count();
-    const double r = std::chrono::duration<double>(t2 - t1).count();
-    sum_s += s;
-    relight_s += r;
-    state.SetIterationTime(r);
+    sum_s.push_back(seconds_since(t0));
+    double dispatched_s = 0.0;
+    for (std::size_t i = 0; i < times.levels().size(); ++i) {
+      const spectral::ForcedSimdLevel forced(spectral::SimdKernel::Relight, times.levels()[i]);
+      const auto t1 = std::chrono::steady_clock::now();
+      relight::relight_into(img, matrix, xyz.data());
+      benchmark::ClobberMemory();
+      const double r = seconds_since(t1);
+      times.add(i, r);
+      if (times.levels()[i] == dispatched) dispatched_s = r;
+    }
+    state.SetIterationTime(dispatched_s);
   }
-  const double n = static_cast<double>(state.iterations());
-  state.counters["relight_GBps"] = bytes * n / relight_s / 1e9;
-  state.counters["sum_GBps"] = bytes * n / sum_s / 1e9;
-  state.counters["ratio"] = relight_s / sum_s;
-  state.counters["relight_ms"] = 1e3 * relight_s / n;
-  state.counters["sum_ms"] = 1e3 * sum_s / n;
-  state.SetBytesProcessed(static_cast<std::int64_t>(bytes * n));
-  relight::detail::relight_simd_force_target("");
+  const double sum_median = median(sum_s);
+  const double relight_median = times.median(times.index_of(dispatched));
+  state.counters["sum_ms"] = 1e3 * sum_median;
+  state.counters["ratio"] = relight_median / sum_median;
+  for (std::size_t i = 0; i < times.levels().size(); ++i)
+    state.counters["ratio_" + std::string(spectral::simd_level_name(times.levels()[i]))] = times.median(i) / sum_median;
+  state.counters["relight_GBps"] = bytes / relight_median / 1e9;
+  state.counters["sum_GBps"] = bytes / sum_median / 1e9;
+  state.counters["load_start"] = load_start;
+  state.counters["load_end"] = bench::load_average();
+  state.SetBytesProcessed(static_cast<std::int64_t>(bytes * static_cast<double>(state.iterations())));
+  times.report(state, dispatched);
 }
 
-BENCHMARK_CAPTURE(BM_RelightVsStreamingSum, best, std::string())
-    ->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK_CAPTURE(BM_RelightVsStreamingSum, AVX2, std::string("AVX2"))
-    ->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK_CAPTURE(BM_RelightVsStreamingSum, SSE4, std::string("SSE4"))
-    ->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_RelightVsStreamingSum)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 // Fluorescent against plain relighting, interleaved in one run: a 512×512 image with 32 bins over
 // 380–780 nm and 2 lights, once without and once with bispectral terms (the 12 bins below 530 nm
@@ -137,7 +154,7 @@ const spectral::SpectralImage& fluorescent_bench_image(bool with_reradiation) {
 }
 
 void BM_FluorescentVsPlainRelight(benchmark::State& state) {
-  state.SetLabel(relight::detail::relight_simd_target());
+  state.SetLabel(relight::detail::relight_simd_target_name(relight::detail::relight_simd_level()));
   std::unique_ptr<tbb::global_control> limit;
   if (state.range(0) > 0) {
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -183,6 +200,36 @@ void BM_FluorescentVsPlainRelight(benchmark::State& state) {
 }
 
 BENCHMARK(BM_FluorescentVsPlainRelight)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// The fluorescent row pass at every SIMD level, interleaved: the image above with its bispectral
+// terms (per light a second term of 3·12 = 36 values per pixel: two whole blocks of 16 and a partial
+// one), K kept as above. Wall time; bench_levels.h's counters. Arg: threads (0 = all).
+void BM_FluorescentRelightLevels(benchmark::State& state) {
+  const auto limit = bench::limit_threads(state.range(0));
+  const spectral::SpectralImage& fl = fluorescent_bench_image(true);
+  std::vector<relight::LightSpec> lights = {relight::parse_light_spec("LED-V1"), relight::parse_light_spec("D65*0.2")};
+  const relight::RelightMatrix matrix(fl.bins, lights, {});
+  const relight::ReradiationWeights k = relight::reradiation_weights(fl, matrix.options().cmf);
+  std::vector<float> xyz(3 * fl.pixel_count());
+  const spectral::SimdLevel dispatched = relight::detail::relight_simd_level();
+  bench::LevelTimes times(relight::detail::relight_simd_levels());
+  for (auto _ : state) {
+    double dispatched_s = 0.0;
+    for (std::size_t i = 0; i < times.levels().size(); ++i) {
+      const spectral::ForcedSimdLevel forced(spectral::SimdKernel::Relight, times.levels()[i]);
+      const auto t0 = std::chrono::steady_clock::now();
+      relight::relight_into(fl, matrix, xyz.data(), &k);
+      benchmark::ClobberMemory();
+      const double r = seconds_since(t0);
+      times.add(i, r);
+      if (times.levels()[i] == dispatched) dispatched_s = r;
+    }
+    state.SetIterationTime(dispatched_s);
+  }
+  times.report(state, dispatched);
+}
+
+BENCHMARK(BM_FluorescentRelightLevels)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 // What verifying prizma:checksum costs when a file is read: read_spectral_exr of a 512×512, 32-bin,
 // two-light float file (its time includes the verification) against spectral_pixel_checksum of the
