@@ -7,8 +7,9 @@
 // second, dispatched level), and bench_levels.h's ms_L, dispatched_ms, best_ms, dispatched_over_best,
 // dispatch_slower; medians over the iterations. Arg: threads (0 = all).
 // Also: the fluorescent row pass at every level (BM_FluorescentRelightLevels), fluorescent against
-// plain relighting (BM_FluorescentVsPlainRelight), and the share of a spectral EXR read spent
-// verifying its pixel checksum (BM_ReadVsChecksum).
+// plain relighting (BM_FluorescentVsPlainRelight), why 512-bit loads made the former AVX-512
+// kernel slow (BM_WideLoadAlignment), and the share of a spectral EXR read spent verifying its pixel
+// checksum (BM_ReadVsChecksum).
 #include <benchmark/benchmark.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -16,7 +17,13 @@
 
 #include <unistd.h>
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
+
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <memory>
@@ -61,16 +68,6 @@ double streaming_sum(const spectral::SpectralImage& img) {
       [](double a, double b) { return a + b; });
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// The median of `v` (not empty).
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
 void BM_RelightVsStreamingSum(benchmark::State& state) {
   const auto limit = bench::limit_threads(state.range(0));
   const double load_start = bench::load_average();
@@ -82,24 +79,14 @@ void BM_RelightVsStreamingSum(benchmark::State& state) {
   const spectral::SimdLevel dispatched = relight::detail::relight_simd_level();
   bench::LevelTimes times(relight::detail::relight_simd_levels());
   std::vector<double> sum_s;
-  for (auto _ : state) {
-    // Interleaved so that all see the same machine load.
-    const auto t0 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(streaming_sum(img));
-    sum_s.push_back(seconds_since(t0));
-    double dispatched_s = 0.0;
-    for (std::size_t i = 0; i < times.levels().size(); ++i) {
-      const spectral::ForcedSimdLevel forced(spectral::SimdKernel::Relight, times.levels()[i]);
-      const auto t1 = std::chrono::steady_clock::now();
-      relight::relight_into(img, matrix, xyz.data());
-      benchmark::ClobberMemory();
-      const double r = seconds_since(t1);
-      times.add(i, r);
-      if (times.levels()[i] == dispatched) dispatched_s = r;
-    }
-    state.SetIterationTime(dispatched_s);
-  }
-  const double sum_median = median(sum_s);
+  bench::time_levels(
+      state, times, spectral::SimdKernel::Relight, dispatched, [&] { relight::relight_into(img, matrix, xyz.data()); },
+      [&] {  // the streaming read first in every round, so that all see the same machine load
+        const auto t0 = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(streaming_sum(img));
+        sum_s.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      });
+  const double sum_median = bench::median_of(sum_s);
   const double relight_median = times.median(times.index_of(dispatched));
   state.counters["sum_ms"] = 1e3 * sum_median;
   state.counters["ratio"] = relight_median / sum_median;
@@ -110,10 +97,11 @@ void BM_RelightVsStreamingSum(benchmark::State& state) {
   state.counters["load_start"] = load_start;
   state.counters["load_end"] = bench::load_average();
   state.SetBytesProcessed(static_cast<std::int64_t>(bytes * static_cast<double>(state.iterations())));
-  times.report(state, dispatched);
 }
 
-BENCHMARK(BM_RelightVsStreamingSum)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+// A fixed number of rounds (every level each time; medians): the slow baseline level would make a
+// minimum time of the dispatched level alone take minutes.
+BENCHMARK(BM_RelightVsStreamingSum)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(15);
 
 // Fluorescent against plain relighting, interleaved in one run: a 512×512 image with 32 bins over
 // 380–780 nm and 2 lights, once without and once with bispectral terms (the 12 bins below 530 nm
@@ -211,25 +199,109 @@ void BM_FluorescentRelightLevels(benchmark::State& state) {
   const relight::RelightMatrix matrix(fl.bins, lights, {});
   const relight::ReradiationWeights k = relight::reradiation_weights(fl, matrix.options().cmf);
   std::vector<float> xyz(3 * fl.pixel_count());
-  const spectral::SimdLevel dispatched = relight::detail::relight_simd_level();
   bench::LevelTimes times(relight::detail::relight_simd_levels());
-  for (auto _ : state) {
-    double dispatched_s = 0.0;
-    for (std::size_t i = 0; i < times.levels().size(); ++i) {
-      const spectral::ForcedSimdLevel forced(spectral::SimdKernel::Relight, times.levels()[i]);
-      const auto t0 = std::chrono::steady_clock::now();
-      relight::relight_into(fl, matrix, xyz.data(), &k);
-      benchmark::ClobberMemory();
-      const double r = seconds_since(t0);
-      times.add(i, r);
-      if (times.levels()[i] == dispatched) dispatched_s = r;
-    }
-    state.SetIterationTime(dispatched_s);
-  }
-  times.report(state, dispatched);
+  bench::time_levels(
+      state, times, spectral::SimdKernel::Relight, relight::detail::relight_simd_level(),
+      [&] { relight::relight_into(fl, matrix, xyz.data(), &k); }, [] {});
 }
 
-BENCHMARK(BM_FluorescentRelightLevels)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_FluorescentRelightLevels)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(25);
+
+#if defined(__x86_64__) && defined(__GNUC__)
+// Why the former AVX-512 relight was the slowest level on the AMD EPYC of issue 26: its loop (per
+// pixel three FMA accumulators, one vector of bins at a time, a horizontal sum each) with 512-bit
+// and with 256-bit loads, over a copy of the transport that starts on a 64-byte boundary and one
+// that starts 16 bytes past it, as glibc starts a large std::vector (the header of its mmap'd
+// chunk): with 32 bins every pixel then starts 16 bytes into a cache line, so every 512-bit load
+// spans two lines and one 256-bit load in two. One thread, the four interleaved; CPU time.
+// Counters: ms_512_aligned, ms_512_offset16, ms_256_aligned, ms_256_offset16 (medians). Needs AVX-512.
+__attribute__((target("avx2,fma"))) float sum_lanes_256(__m256 v) {
+  const __m128 h = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  const __m128 q = _mm_add_ps(h, _mm_movehl_ps(h, h));
+  return _mm_cvtss_f32(_mm_add_ss(q, _mm_movehdup_ps(q)));
+}
+// GCC 12's AVX-512 extract intrinsics (inside _mm512_reduce_add_ps) take an _mm512_undefined_ps()
+// operand that its -Wmaybe-uninitialized reports: a false positive of those headers.
+#if !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+__attribute__((target("avx512f"))) void wide_relight_512(const float* const* layers, const float* w, std::size_t pixels,
+                                                          float* out) {
+  for (std::size_t p = 0; p < pixels; ++p) {
+    __m512 a0 = _mm512_setzero_ps(), a1 = _mm512_setzero_ps(), a2 = _mm512_setzero_ps();
+    for (int l = 0; l < 2; ++l)
+      for (int i = 0; i < kBins; i += 16) {
+        const __m512 v = _mm512_loadu_ps(layers[l] + p * kBins + static_cast<std::size_t>(i));
+        a0 = _mm512_fmadd_ps(_mm512_loadu_ps(w + i), v, a0);
+        a1 = _mm512_fmadd_ps(_mm512_loadu_ps(w + kBins + i), v, a1);
+        a2 = _mm512_fmadd_ps(_mm512_loadu_ps(w + 2 * kBins + i), v, a2);
+      }
+    out[3 * p] = _mm512_reduce_add_ps(a0);
+    out[3 * p + 1] = _mm512_reduce_add_ps(a1);
+    out[3 * p + 2] = _mm512_reduce_add_ps(a2);
+  }
+}
+#if !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+__attribute__((target("avx2,fma"))) void wide_relight_256(const float* const* layers, const float* w, std::size_t pixels,
+                                                           float* out) {
+  for (std::size_t p = 0; p < pixels; ++p) {
+    __m256 a0 = _mm256_setzero_ps(), a1 = _mm256_setzero_ps(), a2 = _mm256_setzero_ps();
+    for (int l = 0; l < 2; ++l)
+      for (int i = 0; i < kBins; i += 8) {
+        const __m256 v = _mm256_loadu_ps(layers[l] + p * kBins + static_cast<std::size_t>(i));
+        a0 = _mm256_fmadd_ps(_mm256_loadu_ps(w + i), v, a0);
+        a1 = _mm256_fmadd_ps(_mm256_loadu_ps(w + kBins + i), v, a1);
+        a2 = _mm256_fmadd_ps(_mm256_loadu_ps(w + 2 * kBins + i), v, a2);
+      }
+    out[3 * p] = sum_lanes_256(a0);
+    out[3 * p + 1] = sum_lanes_256(a1);
+    out[3 * p + 2] = sum_lanes_256(a2);
+  }
+}
+
+void BM_WideLoadAlignment(benchmark::State& state) {
+  if (!__builtin_cpu_supports("avx512f")) {
+    state.SkipWithError("no AVX-512 on this CPU");
+    return;
+  }
+  const spectral::SpectralImage& img = bench_image();
+  const std::size_t n = img.pixel_count() * kBins;
+  // Both layers at float offset 0 (64-byte aligned) and 4 (16 bytes past) of 64-byte aligned buffers.
+  struct Copy {
+    float* base = nullptr;
+    const float* layers[2] = {nullptr, nullptr};
+  };
+  Copy copies[2];
+  for (int o = 0; o < 2; ++o) {
+    copies[o].base = static_cast<float*>(std::aligned_alloc(64, 2 * (n + 16) * sizeof(float)));
+    for (int l = 0; l < 2; ++l) {
+      float* dst = copies[o].base + static_cast<std::size_t>(l) * (n + 16) + (o == 0 ? 0 : 4);
+      std::memcpy(dst, img.lights[static_cast<std::size_t>(l)].data.data(), n * sizeof(float));
+      copies[o].layers[l] = dst;
+    }
+  }
+  alignas(64) float w[3 * kBins];
+  for (int i = 0; i < 3 * kBins; ++i) w[i] = 0.01f * static_cast<float>(i % 7 + 1);
+  std::vector<float> out(3 * img.pixel_count());
+  std::vector<double> ms[4];  // 512 aligned, 512 +16, 256 aligned, 256 +16
+  for (auto _ : state) {
+    for (int k = 0; k < 4; ++k) {
+      const double c0 = bench::process_cpu_seconds();
+      (k < 2 ? wide_relight_512 : wide_relight_256)(copies[k % 2].layers, w, img.pixel_count(), out.data());
+      benchmark::ClobberMemory();
+      ms[k].push_back(1e3 * (bench::process_cpu_seconds() - c0));
+    }
+  }
+  for (Copy& c : copies) std::free(c.base);
+  const char* names[4] = {"ms_512_aligned", "ms_512_offset16", "ms_256_aligned", "ms_256_offset16"};
+  for (int k = 0; k < 4; ++k) state.counters[names[k]] = bench::median_of(ms[k]);
+}
+
+BENCHMARK(BM_WideLoadAlignment)->Unit(benchmark::kMillisecond)->Iterations(10);
+#endif
 
 // What verifying prizma:checksum costs when a file is read: read_spectral_exr of a 512×512, 32-bin,
 // two-light float file (its time includes the verification) against spectral_pixel_checksum of the
