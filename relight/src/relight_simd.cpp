@@ -13,9 +13,10 @@
 // starts a large allocation 16 bytes past a page boundary (the header of its mmap'd chunk), so
 // with 32 bins every pixel starts 16 bytes past a 64-byte line: every 512-bit load of it spans two
 // lines, against one 256-bit load in two. On the AMD EPYC (family 1Ah) of issue 26 the former
-// 512-bit kernel took 1.3–1.8× the CPU time of the same loop with 256-bit loads (at 2.4× the
-// streaming read there against 1.35×), and on 64-byte aligned rows it was no faster than 256-bit
-// loads (docs/results.md, "SIMD dispatch").
+// 512-bit kernel was the slowest level (2.4× the streaming read, quiet, against 1.35× at AVX2;
+// 1.3–1.8× the CPU time of the same loop with 256-bit loads, interleaved on the loaded VM), and on
+// 64-byte aligned rows it was no faster than 256-bit loads (bench_relight BM_WideLoadAlignment;
+// docs/results.md, "SIMD dispatch").
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "relight_simd.cpp"
 #define HWY_DISABLED_TARGETS HWY_SSSE3  // SSE4 is the 128-bit level (simd_choice.h)
