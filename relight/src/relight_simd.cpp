@@ -21,6 +21,7 @@
 #define HWY_TARGET_INCLUDE "relight_simd.cpp"
 #define HWY_DISABLED_TARGETS HWY_SSSE3  // SSE4 is the 128-bit level (simd_choice.h)
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/cache_control.h>
 #include <hwy/highway.h>
 
 #include <algorithm>
@@ -43,6 +44,10 @@ constexpr std::size_t kLanes = hn::MaxLanes(D());
 constexpr std::size_t kVectors = kSums / kLanes;  // vectors per block of 16 values
 static_assert(kSums % kLanes == 0, "a block of sums is whole vectors");
 using Vectors = std::make_index_sequence<kVectors>;
+// How far ahead of a pixel its terms' values are prefetched. Interleaved CPU time of one thread
+// over the 1024² bench image on the loaded VM, against no prefetch: 1 KB ahead 7 % more, 2 KB 6 %
+// less, 4 KB 12 % less, 6–8 KB 15–20 % less (the hardware prefetcher alone leaves loads waiting).
+constexpr std::size_t kPrefetchBytes = 8192;
 
 // A term as the row pass reads it: where pixel 0's values start, values per pixel, its weights in
 // three rows `stride` floats apart (a multiple of 16 floats, zeros past n, 64-byte aligned), how
@@ -163,6 +168,10 @@ void RelightRowTermsSimd(const SimdTerm* terms, int term_count, std::size_t firs
   }
   for (int x = 0; x < width; ++x) {
     const std::size_t p = first_pixel + static_cast<std::size_t>(x);
+    for (std::size_t l = 0; l < count; ++l) {  // each cache line of the values once (prefetches never fault)
+      const char* ahead = reinterpret_cast<const char*>(rows[l].values + p * rows[l].n) + kPrefetchBytes;
+      for (std::size_t b = 0; b < rows[l].n * sizeof(float); b += 64) hwy::Prefetch(ahead + b);
+    }
     if constexpr (kVectors <= 4) {
       // The three channels' sums at once (6 vectors on AVX2, 12 on SSE4): each value is loaded once.
       pixel_channels<3>(rows.data(), count, p, 0, out + 3 * x, std::make_index_sequence<3>());
