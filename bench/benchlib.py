@@ -16,13 +16,14 @@ def build_dir():
 
 
 def ensure_built(target):
-    """Configures (with PRIZMA_BUILD_BENCH=ON) and builds `target` in the bench build folder (-j2)."""
+    """Configures (with PRIZMA_BUILD_BENCH=ON) and builds `target` in the bench build folder
+    (-j$PRIZMA_JOBS, default 2)."""
     bdir = build_dir()
     exe = bdir / "bench" / target
     if not (bdir / "CMakeCache.txt").exists():
         subprocess.run(["cmake", "-S", str(ROOT), "-B", str(bdir), "-DPRIZMA_BUILD_BENCH=ON"], check=True)
-    subprocess.run(["cmake", "--build", str(bdir), "-j2", "--target", target], check=True,
-                   stdout=subprocess.DEVNULL)
+    subprocess.run(["cmake", "--build", str(bdir), "-j" + os.environ.get("PRIZMA_JOBS", "2"), "--target", target],
+                   check=True, stdout=subprocess.DEVNULL)
     return exe
 
 

@@ -9,6 +9,8 @@
 // start and end, k per light, and the compressed frame's error against the exact one: ΔE00
 // p99 and max over all pixels (Lab relative to the mix's white) and the 8-bit codes that differ.
 // Arg: threads (0 = all).
+// BM_CompressedFrameLevels / BM_HalfToFloatLevels: the fused frame and relight_compressed_into (its
+// half → float rows) at every SIMD level, interleaved, with bench_levels.h's counters.
 //
 // `bench_compressed --scene FILE.exr` instead prints, per light of a spectral EXR, the k chosen and
 // the ΔE00 p99 / max under D65, A, F11 and gaussian:450:20 (docs/results.md's per-scene table).
@@ -22,11 +24,14 @@
 #include <cstring>
 #include <ctime>
 #include <memory>
+#include <random>
 #include <string>
 
 #include "bench_image.h"
+#include "bench_levels.h"
 #include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/relight_image.h"
+#include "prizma/relight/relight_simd.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/spectral_exr.h"
 
@@ -164,6 +169,58 @@ void BM_Compress4K(benchmark::State& state) {
 }
 
 BENCHMARK(BM_Compress4K)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// For the SIMD levels: a 1920×1080 transport of 2 lights with k = 4 half coefficients each (what
+// the 4K image above gets), random, made directly rather than by compressing (a short set-up).
+const relight::CompressedTransport& level_transport() {
+  static const relight::CompressedTransport t = [] {
+    relight::CompressedTransport out;
+    out.width = 1920;
+    out.height = 1080;
+    out.bins = spectral::BinLayout::linear(400.0, 700.0, kBins);
+    std::mt19937 rng(26);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (const char* name : {"key", "back"}) {
+      relight::CompressedLayer layer;
+      layer.name = name;
+      const Eigen::MatrixXf basis = Eigen::MatrixXf::NullaryExpr(kBins, 4, [&] { return 0.25f * u(rng); });
+      std::vector<float> c(out.pixel_count() * 4);
+      for (float& v : c) v = u(rng);
+      relight::set_half_coefficients(layer, basis, c);
+      out.lights.push_back(std::move(layer));
+    }
+    return out;
+  }();
+  return t;
+}
+
+// `frame` at every level of `kernel`, interleaved (bench_levels.h).
+template <class Frame>
+void time_kernel_levels(benchmark::State& state, spectral::SimdKernel kernel, Frame&& frame) {
+  const auto limit = bench::limit_threads(state.range(0));
+  bench::LevelTimes times(relight::detail::kernel_simd_levels(kernel));
+  bench::time_levels(state, times, kernel, relight::detail::kernel_simd_level(kernel), frame, [] {});
+}
+
+void BM_CompressedFrameLevels(benchmark::State& state) {
+  const relight::CompressedTransport& t = level_transport();
+  const relight::RelightMatrix matrix(t.bins, {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")}, {});
+  const spectral::DisplayTransform display(spectral::DisplayOptions{});
+  const relight::DisplayEncoder8 encoder(display);
+  std::vector<std::uint8_t> rgb(3 * t.pixel_count());
+  time_kernel_levels(state, spectral::SimdKernel::CompressedFrame,
+              [&] { relight::relight_compressed_to_display8(t, matrix, encoder, rgb.data()); });
+}
+
+void BM_HalfToFloatLevels(benchmark::State& state) {
+  const relight::CompressedTransport& t = level_transport();
+  const relight::RelightMatrix matrix(t.bins, {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")}, {});
+  std::vector<float> xyz(3 * t.pixel_count());
+  time_kernel_levels(state, spectral::SimdKernel::HalfToFloat, [&] { relight::relight_compressed_into(t, matrix, xyz.data()); });
+}
+
+BENCHMARK(BM_CompressedFrameLevels)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(20);
+BENCHMARK(BM_HalfToFloatLevels)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(20);
 
 int scene_report(const char* path) {
   const spectral::SpectralImage img = spectral::read_spectral_exr(path);

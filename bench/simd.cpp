@@ -2,7 +2,9 @@
 // peer scene (data/scenes/bench_peer.json, 32 bins, no lights but the environment: free flight,
 // phase sampling, roulette) and of the chromatic cube (cube_sphere.json: also a key light, so
 // next-event estimation and ratio tracking), every level in turn in each round (interleaved, so a
-// change in the machine's load falls on all of them), and each level's speed-up over the baseline.
+// change in the machine's load falls on all of them), and each level's speed-up over the baseline;
+// with bench_levels.h's counters (ms_L: CPU ms of one round at level L, median; the dispatched
+// level, default_simd_level(), against the fastest).
 //
 //   build/bench/bench_simd [--benchmark_filter=Peer]
 #include <benchmark/benchmark.h>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "bench_common.h"
+#include "bench_levels.h"
 #include "prizma/render/camera.h"
 #include "prizma/render/path_tracer.h"
 #include "prizma/render/rng.h"
@@ -51,12 +54,16 @@ void simd_levels(benchmark::State& state, const std::string& scene_file, int pat
   tracer.prepare(s, bins.size());
   const std::vector<pr::SimdLevel> levels = pr::supported_simd_levels();
   std::vector<double> seconds(levels.size(), 0.0);
+  prizma::bench::LevelTimes times(levels);
   for (auto _ : state) {
-    for (std::size_t l = 0; l < levels.size(); ++l) {
+    for (const std::size_t l : times.next_order()) {
       tracer.set_simd_level(levels[l]);
-      seconds[l] += trace_paths(scene, tracer, s, paths_per_round);
+      const double round_s = trace_paths(scene, tracer, s, paths_per_round);  // CPU time of this thread
+      seconds[l] += round_s;
+      times.add(l, round_s, round_s);
     }
   }
+  times.report(state, pr::default_simd_level());
   const double paths = static_cast<double>(state.iterations()) * paths_per_round;
   for (std::size_t l = 0; l < levels.size(); ++l) {
     const std::string name(pr::simd_level_name(levels[l]));
@@ -65,8 +72,8 @@ void simd_levels(benchmark::State& state, const std::string& scene_file, int pat
   }
 }
 
-BENCHMARK_CAPTURE(simd_levels, Peer, std::string("bench_peer.json"), 2000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK_CAPTURE(simd_levels, Cube, std::string("cube_sphere.json"), 500)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(simd_levels, Peer, std::string("bench_peer.json"), 2000)->Unit(benchmark::kMillisecond)->MinTime(1.5);
+BENCHMARK_CAPTURE(simd_levels, Cube, std::string("cube_sphere.json"), 500)->Unit(benchmark::kMillisecond)->MinTime(1.5);
 
 }  // namespace
 

@@ -182,6 +182,7 @@ void relight_compressed_into(const CompressedTransport& transport, const Relight
   const int width = transport.width;
   int max_k = 1;
   for (const CoeffTerm& t : terms) max_k = std::max(max_k, t.k);
+  const detail::HalfToFloatKernel half_to_float = detail::half_to_float_kernel();  // the SIMD level chosen now
   tbb::parallel_for(tbb::blocked_range<int>(0, transport.height), [&](const tbb::blocked_range<int>& rows) {
     std::vector<float> row(static_cast<std::size_t>(width) * static_cast<std::size_t>(max_k));
     for (int y = rows.begin(); y != rows.end(); ++y) {
@@ -190,7 +191,7 @@ void relight_compressed_into(const CompressedTransport& transport, const Relight
       std::fill(out, out + 3 * static_cast<std::size_t>(width), 0.0f);
       for (std::size_t t = 0; t < terms.size(); ++t) {
         const std::size_t count = static_cast<std::size_t>(width) * static_cast<std::size_t>(terms[t].k);
-        detail::half_to_float(terms[t].coefficients + first * static_cast<std::size_t>(terms[t].k), count, row.data());
+        half_to_float(terms[t].coefficients + first * static_cast<std::size_t>(terms[t].k), count, row.data());
         kernels[t](terms[t], row.data(), width, out);
       }
     }
@@ -525,12 +526,12 @@ void relight_compressed_to_display8(const CompressedTransport& transport, const 
   enc.hi_bits = steps.hi_bits;
   const int width = transport.width;
   const std::size_t scratch_floats = detail::compressed_row_scratch(terms.data(), static_cast<int>(terms.size()), width);
+  const detail::CompressedRowKernel row_kernel = detail::compressed_row_kernel();  // the SIMD level chosen now
   tbb::parallel_for(tbb::blocked_range<int>(0, transport.height), [&](const tbb::blocked_range<int>& rows) {
     std::vector<float> scratch(scratch_floats);
     for (int y = rows.begin(); y != rows.end(); ++y) {
       const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
-      detail::compressed_row_to_display8(terms.data(), static_cast<int>(terms.size()), first, width, enc, scratch.data(),
-                                         rgb_out + 3 * first);
+      row_kernel(terms.data(), static_cast<int>(terms.size()), first, width, enc, scratch.data(), rgb_out + 3 * first);
     }
   });
 }

@@ -1,16 +1,19 @@
-// The fused compressed-relight row (compressed_simd.h), compiled for every x86 SIMD level with
-// Highway and chosen at run time, as relight_simd.cpp does. Per block of lanes: the half
-// coefficients of each light are de-interleaved (LoadInterleaved2/3/4 of 16-bit lanes for k ≤ 4;
-// layers of larger k are first converted for the whole row and gathered), widened to float (F16C
-// where the target has it: exact either way), multiplied into linear display RGB with the folded 3×k
-// weights, and each channel is encoded by the step table: one gather of a 32-bit entry (the code
-// and where the next step lies), one integer compare; the codes are narrowed to bytes and stored interleaved. Each
-// coefficient is read from memory once and nothing but the 8-bit codes is written. The row's tail
-// goes through the same block on zero-padded copies, so every pixel gets the same arithmetic.
-// Targets differ only in float rounding of the sums (FMA or not); one machine always gives the
-// same bytes.
+// The fused compressed-relight row (compressed_simd.h), compiled by Highway for every x86 level and
+// run at the level spectral::choose_simd_level picks (hwy_levels.h), as relight_simd.cpp is. Per
+// block of lanes (one pixel per lane): the half coefficients of each light are de-interleaved
+// (LoadInterleaved2/3/4 of 16-bit lanes for k ≤ 4; layers of larger k are first converted for the
+// whole row and gathered), widened to float (F16C where the target has it: exact either way),
+// multiplied into linear display RGB with the folded 3×k weights, and each channel is encoded by
+// the step table: one gather of a 32-bit entry (the code and where the next step lies), one integer
+// compare; the codes are narrowed to bytes and stored interleaved. Each coefficient is read from
+// memory once and nothing but the 8-bit codes is written. The row's tail goes through the same
+// block on zero-padded copies, so every pixel gets the same arithmetic.
+// Same bytes at every level: a pixel is one lane, its sums run over the layers and coefficients in
+// the same order at every width, each a product rounded then a sum rounded (no FMA: this file is
+// compiled with -ffp-contract=off); the encoding is integer (tests/relight/compressed_relight_test.cpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "compressed_simd.cpp"
+#define HWY_DISABLED_TARGETS HWY_SSSE3  // SSE4 is the 128-bit level (simd_choice.h)
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/cache_control.h>
 #include <hwy/highway.h>
@@ -53,10 +56,10 @@ HWY_INLINE void block(const SimdCoeffLayer* layers, int layer_count, const std::
   for (int l = 0; l < layer_count; ++l) {
     const int k = layers[l].k;
     const float* HWY_RESTRICT w = layers[l].weights;
-    auto add = [&](int j, VF cj) {
-      r = hn::MulAdd(hn::Set(d, w[j]), cj, r);
-      g = hn::MulAdd(hn::Set(d, w[k + j]), cj, g);
-      b = hn::MulAdd(hn::Set(d, w[2 * k + j]), cj, b);
+    auto add = [&](int j, VF cj) HWY_ATTR {
+      r = hn::Add(r, hn::Mul(hn::Set(d, w[j]), cj));
+      g = hn::Add(g, hn::Mul(hn::Set(d, w[k + j]), cj));
+      b = hn::Add(b, hn::Mul(hn::Set(d, w[2 * k + j]), cj));
     };
     const std::uint16_t* HWY_RESTRICT c = coeff[l];
     if (k == 4) {
@@ -167,18 +170,28 @@ void CompressedRowToDisplay8(const SimdCoeffLayer* layers, int layer_count, std:
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "hwy_levels.h"
+
 namespace prizma::relight::detail {
 
 HWY_EXPORT(CompressedRowToDisplay8);
 HWY_EXPORT(HalfToFloat);
 
-void compressed_row_to_display8(const SimdCoeffLayer* layers, int layer_count, std::size_t first_pixel, int width,
-                                const SimdEncoder& encoder, float* scratch, std::uint8_t* out) {
-  HWY_DYNAMIC_DISPATCH(CompressedRowToDisplay8)(layers, layer_count, first_pixel, width, encoder, scratch, out);
+std::vector<spectral::SimdLevel> compressed_frame_levels() { return hwy_levels(HWY_DISPATCH_TABLE(CompressedRowToDisplay8)); }
+std::vector<spectral::SimdLevel> half_to_float_levels() { return hwy_levels(HWY_DISPATCH_TABLE(HalfToFloat)); }
+
+CompressedRowKernel compressed_row_kernel(spectral::SimdLevel level) {
+  return hwy_function(HWY_DISPATCH_TABLE(CompressedRowToDisplay8), level);
+}
+CompressedRowKernel compressed_row_kernel() {
+  return compressed_row_kernel(spectral::choose_simd_level(spectral::SimdKernel::CompressedFrame, compressed_frame_levels()));
 }
 
-void half_to_float(const std::uint16_t* in, std::size_t count, float* out) {
-  HWY_DYNAMIC_DISPATCH(HalfToFloat)(in, count, out);
+HalfToFloatKernel half_to_float_kernel(spectral::SimdLevel level) {
+  return hwy_function(HWY_DISPATCH_TABLE(HalfToFloat), level);
+}
+HalfToFloatKernel half_to_float_kernel() {
+  return half_to_float_kernel(spectral::choose_simd_level(spectral::SimdKernel::HalfToFloat, half_to_float_levels()));
 }
 
 }  // namespace prizma::relight::detail

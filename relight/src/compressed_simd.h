@@ -1,9 +1,13 @@
 #pragma once
-// The fused row kernel of relight_compressed_to_display8 (compressed_simd.cpp, Highway run-time
-// dispatch like relight_simd.cpp): half coefficients → linear display RGB → 8-bit codes, one row at
-// a time; and the half → float conversion of relight_compressed_into.
+// The fused row kernel of relight_compressed_to_display8 (compressed_simd.cpp, compiled for every
+// SIMD level and run at the one spectral::choose_simd_level picks, like relight_simd.cpp): half
+// coefficients → linear display RGB → 8-bit codes, one row at a time; and the half → float
+// conversion of relight_compressed_into. Every level gives the same bytes.
 #include <cstddef>
 #include <cstdint>
+#include <vector>
+
+#include "prizma/spectral/simd_choice.h"
 
 namespace prizma::relight::detail {
 
@@ -39,10 +43,20 @@ inline std::size_t compressed_row_scratch(const SimdCoeffLayer* layers, int laye
 
 // out[3x + c] for x in [0, width): the codes of pixel first_pixel + x. At most kMaxFusedLayers
 // layers; `scratch`: compressed_row_scratch(layers, layer_count, width) floats.
-void compressed_row_to_display8(const SimdCoeffLayer* layers, int layer_count, std::size_t first_pixel, int width,
-                                const SimdEncoder& encoder, float* scratch, std::uint8_t* out);
+using CompressedRowKernel = void (*)(const SimdCoeffLayer* layers, int layer_count, std::size_t first_pixel, int width,
+                                     const SimdEncoder& encoder, float* scratch, std::uint8_t* out);
+// The levels it is built for that this CPU runs (lowest first), and the kernel at the level chosen
+// for SimdKernel::CompressedFrame now (look it up once per frame) or at a given one.
+std::vector<spectral::SimdLevel> compressed_frame_levels();
+CompressedRowKernel compressed_row_kernel();
+CompressedRowKernel compressed_row_kernel(spectral::SimdLevel level);
 
-// out[i] = the float of half bits in[i] (exact), i < count.
-void half_to_float(const std::uint16_t* in, std::size_t count, float* out);
+// out[i] = the float of half bits in[i] (exact), i < count. The same for SimdKernel::HalfToFloat.
+using HalfToFloatKernel = void (*)(const std::uint16_t* in, std::size_t count, float* out);
+std::vector<spectral::SimdLevel> half_to_float_levels();
+HalfToFloatKernel half_to_float_kernel();
+HalfToFloatKernel half_to_float_kernel(spectral::SimdLevel level);
+// One conversion through half_to_float_kernel() (outside loops over rows or pixels).
+inline void half_to_float(const std::uint16_t* in, std::size_t count, float* out) { half_to_float_kernel()(in, count, out); }
 
 }  // namespace prizma::relight::detail

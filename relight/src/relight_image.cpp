@@ -122,11 +122,12 @@ void relight_into(const spectral::SpectralImage& image, const RelightMatrix& mat
     add_reradiation_terms(image, matrix, *k, rerad_weights, terms);
   }
   const int width = image.width;
+  // The SIMD level chosen for this CPU (relight_simd.h): every level gives the same bits.
+  const detail::RelightRowKernel row = detail::relight_row_kernel();
   tbb::parallel_for(tbb::blocked_range<int>(0, image.height), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y != rows.end(); ++y) {
       const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
-      // Highway's run-time dispatch: the widest SIMD this CPU has (relight_simd.cpp).
-      detail::relight_row_terms_simd(terms.data(), static_cast<int>(terms.size()), first, width, xyz_out + 3 * first);
+      row(terms.data(), static_cast<int>(terms.size()), first, width, xyz_out + 3 * first);
     }
   });
 }

@@ -332,7 +332,7 @@ void PathTracer::classify(float value, std::uint16_t& material, float& density) 
 void PathTracer::set_simd_level(SimdLevel level) {
   const std::vector<SimdLevel> levels = supported_simd_levels();
   if (std::find(levels.begin(), levels.end(), level) == levels.end())
-    throw spectral::InputError("simd", std::string(simd_level_name(level)) + " is not supported by this CPU");
+    throw spectral::InputError("simd", "the tracer has no " + std::string(simd_level_name(level)) + " level on this CPU");
   m_simd = level;
 }
 
@@ -344,6 +344,7 @@ void PathTracer::trace(const Ray& ray, Rng& rng, PathScratch& s) const {
     case SimdLevel::Avx2:
       trace_avx2(ray, rng, s);
       return;
+    case SimdLevel::Sse4:  // not a tracer level: supported_simd_levels() never lists it
     case SimdLevel::Baseline:
       break;
   }

@@ -155,6 +155,18 @@ if(TARGET prizma-relight)
                    good.exr --light csv:nan.csv -o relight_light_nan.png)
 endif()
 
+# An unknown PRIZMA_SIMD level (simd_choice.h; docs/renderer.md, "SIMD levels"): both tools refuse it
+# with one line and exit 2, before writing anything; an existing output is kept.
+if(TARGET prizma-render AND TARGET prizma-relight)
+  set(_simd_reason "unknown SIMD level \"avx1024\" \\(known: baseline, sse4, avx2, avx512\\)")
+  prizma_error_e2e(render_simd_level prizma-render 2 "^PRIZMA_SIMD: " "${_simd_reason}" render_simd_level.exr EXISTING
+                   good.json -q -o render_simd_level.exr)
+  prizma_error_e2e(relight_simd_level prizma-relight 2 "^PRIZMA_SIMD: " "${_simd_reason}" relight_simd_level.png EXISTING
+                   good.exr -o relight_simd_level.png)
+  set_property(TEST errors.e2e.render_simd_level errors.e2e.relight_simd_level APPEND PROPERTY ENVIRONMENT
+               "PRIZMA_SIMD=avx1024")
+endif()
+
 # Out of memory wherever it happens (issue 11): under a series of address-space limits each run is
 # a success or exit 1 with one "out of memory" line (below ~16 MB for prizma-render, ~40 MB for
 # prizma-relight, the dynamic loader itself cannot map the libraries: exit 127 with ld.so's own

@@ -103,6 +103,18 @@ TEST(SimdLevels, BaselineAlwaysSupportedAndNamesRoundTrip) {
   EXPECT_THROW(parse_simd_level("sse9", "PRIZMA_SIMD"), spectral::InputError);
 }
 
+TEST(SimdLevels, ATracerStartsAtTheChosenLevel) {
+  // spectral::choose_simd_level for SimdKernel::Tracer: forced here (PRIZMA_SIMD or a rule the same way).
+  const Scene scene = load_scene(std::filesystem::path(PRIZMA_TEST_DATA_DIR) / "scenes" / "bench_peer.json");
+  for (SimdLevel l : supported_simd_levels()) {
+    const spectral::ForcedSimdLevel forced(spectral::SimdKernel::Tracer, l);
+    EXPECT_EQ(default_simd_level(), l);
+    EXPECT_EQ(PathTracer(scene, 400, 700, true).simd_level(), l) << simd_level_name(l);
+  }
+  const spectral::ForcedSimdLevel sse4(spectral::SimdKernel::Tracer, SimdLevel::Sse4);
+  EXPECT_EQ(default_simd_level(), SimdLevel::Baseline) << "no SSE4 level: the one below";
+}
+
 TEST(SimdLevels, UnsupportedLevelIsRefused) {
   const Scene scene = load_scene(std::filesystem::path(PRIZMA_TEST_DATA_DIR) / "scenes" / "bench_peer.json");
   PathTracer tracer(scene, 400, 700, true);

@@ -1,8 +1,11 @@
 #pragma once
-// The relight row kernel with run-time SIMD dispatch (relight_simd.cpp, Highway).
+// The relight row kernel, compiled for every SIMD level and run at the one
+// spectral::choose_simd_level picks (relight_simd.cpp, Highway; docs/relight.md, "SIMD levels").
 #include <cstddef>
 #include <string>
 #include <vector>
+
+#include "prizma/spectral/simd_choice.h"
 
 namespace prizma::relight::detail {
 
@@ -11,18 +14,34 @@ namespace prizma::relight::detail {
 // A light's transport layer is a term (n_t = bins, weights its 3×n relight matrix); a bispectral
 // light's re-radiation weights K (3·|in bins| values per pixel, relight_image.h) are another, with
 // weights output[c][c']·ē[in] (relight_image.cpp), so the K·ē product shares the diagonal's row pass.
+// `values` must hold the whole row (first_pixel … first_pixel + width − 1).
 struct SimdTerm {
   const float* weights;  // 3·n floats, row-major
   const float* values;   // n floats per pixel, pixel-major
   int n;
 };
-void relight_row_terms_simd(const SimdTerm* terms, int term_count, std::size_t first_pixel, int width, float* out);
+using RelightRowKernel = void (*)(const SimdTerm* terms, int term_count, std::size_t first_pixel, int width, float* out);
 
-// The targets compiled in that this CPU runs, best first (e.g. "AVX3", "AVX2", "SSE4", …, "EMU128").
-std::vector<std::string> relight_simd_targets();
-// The one relight_row_terms_simd uses now.
-std::string relight_simd_target();
-// Tests: use only the named target from now on ("" = back to the best). Not thread-safe.
-void relight_simd_force_target(const std::string& name);
+// How many running sums per pixel and channel every level keeps (value j goes into sum j mod 16):
+// the order of the additions, the same at every level, so every level gives the same bits.
+constexpr int kRelightSums = 16;
+
+// The levels the kernel is built for that this CPU runs, lowest first (Baseline always).
+std::vector<spectral::SimdLevel> relight_simd_levels();
+// The level spectral::choose_simd_level(SimdKernel::Relight, relight_simd_levels()) picks now.
+// Throws InputError("PRIZMA_SIMD", …) for an unknown value of the variable.
+spectral::SimdLevel relight_simd_level();
+// The kernel at relight_simd_level(): look it up once per image, not per row.
+RelightRowKernel relight_row_kernel();
+// The kernel at `level` (one of relight_simd_levels()).
+RelightRowKernel relight_row_kernel(spectral::SimdLevel level);
+// Highway's name of the target compiled for `level` ("AVX3", "AVX2", "SSE4", "EMU128"…), for labels.
+std::string relight_simd_target_name(spectral::SimdLevel level);
+
+// The same for each kernel of this library (SimdKernel::Relight, CompressedFrame, HalfToFloat; the
+// Tracer's are render::supported_simd_levels()), for tests and benchmarks: its levels on this CPU,
+// lowest first, and the one the tools run it at now.
+std::vector<spectral::SimdLevel> kernel_simd_levels(spectral::SimdKernel kernel);
+spectral::SimdLevel kernel_simd_level(spectral::SimdKernel kernel);
 
 }  // namespace prizma::relight::detail
