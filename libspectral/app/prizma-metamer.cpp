@@ -306,7 +306,7 @@ int main(int argc, char** argv) {
   sub_metamer->add_option("--albedo", metamer.albedo, "the reflectance to match")->required();
   sub_metamer->add_option("--match-light", metamer.match_light, "light under which both look the same")->required();
   sub_metamer->add_option("--split-light", metamer.split_light, "light under which they should differ most")->required();
-  sub_metamer->add_option("-o,--output", metamer.output, "output CSV (nm, reflectance)")->required();
+  sub_metamer->add_option("-o,--output", metamer.output, "output CSV (nm, reflectance)")->required()->check(ps::non_empty_path());
   sub_metamer->add_option("--basis", metamer.basis, "number of B-spline basis functions (smoothness)")
       ->capture_default_str()->check(CLI::Range(6, 200));
   sub_metamer->add_option("--min", metamer.min_value, "lower bound of the reflectance")->capture_default_str();
@@ -317,7 +317,7 @@ int main(int argc, char** argv) {
       "light", "design a light (same luminance as --reference) that hides or reveals the difference of two albedos");
   sub_light->add_option("--albedo-a", light.albedo_a, "first albedo spectrum");
   sub_light->add_option("--albedo-b", light.albedo_b, "second albedo spectrum");
-  sub_light->add_option("--scene", light.scene, "scene JSON to read materials' albedos from");
+  sub_light->add_option("--scene", light.scene, "scene JSON to read materials' albedos from")->check(ps::non_empty_path());
   sub_light->add_option("--material-a", light.material_a, "first material's name (or index) in --scene");
   sub_light->add_option("--material-b", light.material_b, "second material's name (or index) in --scene");
   sub_light->add_flag("--hide", light.hide, "make the two look the same (dE00 -> 0)");
@@ -330,7 +330,9 @@ int main(int argc, char** argv) {
   sub_light->add_option("--max-power-ratio", light.max_power_ratio,
                         "radiant power at most this many times the reference's at equal luminance (0: no limit)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
-  sub_light->add_option("-o,--output", light.output, "output CSV (nm, relative spectral power)")->required();
+  sub_light->add_option("-o,--output", light.output, "output CSV (nm, relative spectral power)")
+      ->required()
+      ->check(ps::non_empty_path());
 
   DeltaECommand delta;
   CLI::App* sub_delta = app.add_subcommand(
@@ -343,7 +345,7 @@ int main(int argc, char** argv) {
   CLI::App* sub_weights = app.add_subcommand(
       "weights", "write the relighter's X,Y,Z weights per bin for --light (white-normalised: sum of Y = 1)");
   sub_weights->add_option("--light", weights.light, "light spectrum")->capture_default_str();
-  sub_weights->add_option("-o,--output", weights.output, "output CSV (lo_nm, hi_nm, X, Y, Z)")->required();
+  sub_weights->add_option("-o,--output", weights.output, "output CSV (lo_nm, hi_nm, X, Y, Z)")->required()->check(ps::non_empty_path());
 
   TabulateCommand tabulate;
   CLI::App* sub_tabulate = app.add_subcommand("tabulate", "write a spectrum spec as a CSV table (for scripts and plots)");
@@ -351,7 +353,7 @@ int main(int argc, char** argv) {
   sub_tabulate->add_option("--from", tabulate.from_nm, "first wavelength (nm)")->capture_default_str();
   sub_tabulate->add_option("--to", tabulate.to_nm, "last wavelength (nm)")->capture_default_str();
   sub_tabulate->add_option("--step", tabulate.step_nm, "step (nm)")->capture_default_str();
-  sub_tabulate->add_option("-o,--output", tabulate.output, "output CSV")->required();
+  sub_tabulate->add_option("-o,--output", tabulate.output, "output CSV")->required()->check(ps::non_empty_path());
 
   if (const int code = ps::parse_command_line(app, argc, argv); code >= 0) return code;
   return ps::run_tool(program, [&]() {

@@ -302,8 +302,10 @@ int compress_main(int argc, char** argv) {
   relight::CompressFileOptions options;
   bool no_verify = false, quiet = false;
   int threads = 0;
-  app.add_option("input", input, "spectral EXR with transport bins")->required();
-  app.add_option("-o,--output", output, "the compressed spectral EXR (written atomically)")->required();
+  app.add_option("input", input, "spectral EXR with transport bins")->required()->check(spectral::non_empty_path());
+  app.add_option("-o,--output", output, "the compressed spectral EXR (written atomically)")
+      ->required()
+      ->check(spectral::non_empty_path());
   app.add_flag("--compact", options.compact,
                "drop the transport bins (and variance): the file is then relit only from the coefficients");
   app.add_option("--max-error", options.criterion.max_delta_e,
@@ -326,9 +328,11 @@ int main(int argc, char** argv) {
   CLI::App app{"Relights a Prizma spectral EXR under any light spectra (no re-render).", "prizma-relight"};
   CliOptions o;
   app.add_option("input", o.input, "spectral EXR written by prizma-render (or any reflective spectral EXR)")
-      ->required();
+      ->required()
+      ->check(spectral::non_empty_path());
   app.add_option("-o,--output", o.output,
-                 "output image: .png (8/16-bit), .tif, .jpg (8-bit), .exr (linear XYZ or --colour-space)");
+                 "output image: .png (8/16-bit), .tif, .jpg (8-bit), .exr (linear XYZ or --colour-space)")
+      ->check(spectral::non_empty_path());
   app.add_option("--light", o.lights,
                  "NAME=SPEC for one light layer, or SPEC for every layer; SPEC: D65, A, F11, LED-B1, "
                  "blackbody:3200K, gaussian:550:20, box:500:560, csv:FILE, off, …*SCALE (repeatable)")
@@ -340,12 +344,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--colour-space,--color-space", o.colour_space,
                  "linear OCIO colour space for EXR output (refused with only a PNG/TIFF/JPEG output)");
-  app.add_option("--ocio", o.ocio, "OpenColorIO config file (default: $OCIO, else Prizma's own)");
+  app.add_option("--ocio", o.ocio, "OpenColorIO config file (default: $OCIO, else Prizma's own)")
+      ->check(spectral::non_empty_path());
   app.add_flag("--absolute", o.absolute, "absolute light units (no normalisation to Y = 1 for white)");
   app.add_option("--bit-depth", o.bit_depth, "PNG/TIFF bit depth")->check(CLI::IsMember({8, 16}))->capture_default_str();
-  app.add_option("--batch", o.batch, "JSON file listing outputs and their settings (docs/relight.md)");
+  app.add_option("--batch", o.batch, "JSON file listing outputs and their settings (docs/relight.md)")
+      ->check(spectral::non_empty_path());
   app.add_flag("-i,--interactive", o.interactive, "read commands from stdin (type 'help')");
-  app.add_option("--preview", o.preview, "interactive: image rewritten after every change");
+  app.add_option("--preview", o.preview, "interactive: image rewritten after every change")
+      ->check(spectral::non_empty_path());
   app.add_flag("--show", o.show, "print a true-colour terminal thumbnail (with -i: draw the image at the start)");
   app.add_flag("--show-every", o.show_every, "interactive: draw the image after every change");
   app.add_flag("-v,--verbose", o.verbose, "echo data files, OCIO config and lights");
@@ -358,7 +365,9 @@ int main(int argc, char** argv) {
   app.add_flag("--serve", o.serve, "serve the live relighting page (prints its URL; Ctrl-C stops it)");
   app.add_option("--bind", o.bind, "--serve: address to listen on")->capture_default_str();
   app.add_option("--port", o.port, "--serve: port (0: a free one)")->check(CLI::Range(0, 65535))->capture_default_str();
-  app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")->capture_default_str();
+  app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")
+      ->capture_default_str()
+      ->check(spectral::non_empty_path());
   app.set_version_flag("--version", prizma::spectral::prizma_version());
   app.footer("Also: prizma-relight compress IN.exr -o OUT.exr [--compact] [--max-error DE] adds spectral-basis "
              "coefficients (prizma-relight compress --help).");

@@ -153,9 +153,12 @@ int merge_main(int argc, char** argv) {
   std::string output, preview;
   bool half = false, quiet = false, verbose = false, strict = false, no_verify = false;
   int threads = 0;
-  app.add_option("shards", inputs, "shard files (spectral EXR written by prizma-render)")->required();
-  app.add_option("-o,--output", output, "merged output file")->required();
-  app.add_option("--preview", preview, "also write an sRGB preview (PNG) under the lights' default spectra");
+  app.add_option("shards", inputs, "shard files (spectral EXR written by prizma-render)")
+      ->required()
+      ->check(spectral::non_empty_path());
+  app.add_option("-o,--output", output, "merged output file")->required()->check(spectral::non_empty_path());
+  app.add_option("--preview", preview, "also write an sRGB preview (PNG) under the lights' default spectra")
+      ->check(spectral::non_empty_path());
   app.add_flag("--half", half, "write half floats");
   app.add_flag("--strict", strict, "refuse shards that leave a gap in the sample range (exit 2)");
   app.add_flag("--no-verify", no_verify,
@@ -208,8 +211,10 @@ int main(int argc, char** argv) {
                kProgram};
   app.set_version_flag("--version", spectral::prizma_version());
   Options o;
-  app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own");
-  app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")");
+  app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own")
+      ->check(spectral::non_empty_path());
+  app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")")
+      ->check(spectral::non_empty_path());
   app.add_option("--spp", o.spp_text, "samples per pixel (renders samples [begin, begin + N); with --resume the total)");
   app.add_option("--width", o.width_text, "image width in pixels");
   app.add_option("--height", o.height_text, "image height in pixels");
@@ -229,10 +234,12 @@ int main(int argc, char** argv) {
   app.add_flag("--no-majorant-grid", o.no_majorant_grid, "one global majorant instead of the macrocell grid");
   app.add_flag("--variance", o.variance, "also write variance-of-the-mean layers");
   app.add_flag("--half", o.half, "write half floats (refused where values exceed half's range)");
-  app.add_option("--preview", o.preview, "also write an sRGB preview (PNG) under the lights' default spectra");
+  app.add_option("--preview", o.preview, "also write an sRGB preview (PNG) under the lights' default spectra")
+      ->check(spectral::non_empty_path());
   app.add_option("--resume", o.resume,
                  "continue a partial (interrupted) render from the scene and options it records, up to "
-                 "its target or --spp N in all, and merge (output defaults to this file)");
+                 "its target or --spp N in all, and merge (output defaults to this file)")
+      ->check(spectral::non_empty_path());
   app.add_flag("--no-verify", o.no_verify,
                "with --resume: read the file even when its pixels do not match prizma:checksum (re-encoded by "
                "another tool: docs/spectral-exr.md)");
@@ -244,7 +251,8 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", o.quiet, "no progress bar or summary");
   app.add_flag("-v,--verbose", o.verbose, "print the scene, mode and statistics");
   std::string ocio;  // accepted only to be refused with the reason (the tools share their vocabulary)
-  app.add_option("--ocio", ocio, "refused: a render converts nothing through OpenColorIO (give --ocio to prizma-relight)");
+  app.add_option("--ocio", ocio, "refused: a render converts nothing through OpenColorIO (give --ocio to prizma-relight)")
+      ->check(spectral::non_empty_path());
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   return spectral::run_tool(kProgram, [&] {

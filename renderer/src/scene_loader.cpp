@@ -535,7 +535,9 @@ std::string absolute_spec(const std::string& spec, const std::filesystem::path& 
   return "csv:" + (base / p).string() + (star == std::string::npos ? "" : spec.substr(star));
 }
 
-// The emission layer's name: as a light's, 1–64 letters, digits, '_' and '-'.
+// A light layer's name (a light's, the emission layer's): 1–64 letters, digits, '_' and '-', and not
+// a name the spectral EXR reserves ("var" names the variance layers): refused here, before rendering,
+// not by the writer after it.
 void check_light_name(const Reader& rd, const std::string& name, const std::string& path) {
   if (name.empty() || name.size() > kMaxLightNameLength) {
     rd.fail(path, "must have 1 to " + std::to_string(kMaxLightNameLength) + " characters (got \"" + name + "\")");
@@ -545,6 +547,7 @@ void check_light_name(const Reader& rd, const std::string& name, const std::stri
       rd.fail(path, "may hold only letters, digits, '_' and '-' (got \"" + name + "\")");
     }
   }
+  spectral::check_exr_light_name(name, rd.input(path));
 }
 
 // A point, sphere or spot light ("position") or an environment map ("environment"), with their
@@ -625,15 +628,7 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
     const std::string np = Reader::join(lp, "name");
     if (!lj.contains("name")) rd.fail(np, "is required");
     l.name = rd.string(lj.at("name"), np);
-    if (l.name.empty() || l.name.size() > kMaxLightNameLength) {
-      rd.fail(np, "must have 1 to " + std::to_string(kMaxLightNameLength) + " characters (got \"" + l.name + "\")");
-    }
-    for (char ch : l.name) {
-      if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-')) {
-        rd.fail(np, "may hold only letters, digits, '_' and '-' (got \"" + l.name + "\")");
-      }
-    }
-    spectral::check_exr_light_name(l.name, rd.input(np));  // "var" names the variance layers
+    check_light_name(rd, l.name, np);
     if (!names.insert(l.name).second) rd.fail(np, "duplicate light name \"" + l.name + "\"");
     const std::string dp = Reader::join(lp, "direction");
     if (lj.contains("position") || lj.contains("environment")) {

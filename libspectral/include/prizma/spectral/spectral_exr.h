@@ -15,7 +15,7 @@ struct SpectralExrInfo {
   std::string lights_json;       // prizma:lights (JSON array of {name, direction, angularSizeDeg, spectrum})
   std::int64_t samples = 0;      // prizma:samples, samples per pixel in this file
   std::string sample_range;      // prizma:sampleRange "A:B"
-  std::int64_t seed = 0;         // prizma:seed
+  std::uint64_t seed = 0;        // prizma:seed (any 64-bit seed: docs/spectral-exr.md)
   std::string scene_hash;        // prizma:sceneHash
   std::string version;           // prizma:version
   std::string wavelength_sampling;  // prizma:wavelengthSampling
