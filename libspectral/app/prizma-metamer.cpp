@@ -174,6 +174,7 @@ int run_metamer(const MetamerCommand& cmd, const CommonOptions& common) {
   const ps::Spectrum albedo = parse_option(cmd.albedo, "--albedo");
   const ps::Spectrum match = parse_option(cmd.match_light, "--match-light");
   const ps::Spectrum split = parse_option(cmd.split_light, "--split-light");
+  ps::check_output_file(cmd.output, "--output");  // again, now that the csv: inputs are read
   const ps::MetamerResult result = ps::design_metamer(albedo, match, split, options);
   ps::write_spectrum_csv(cmd.output, result.reflectance, "reflectance");
 
@@ -213,6 +214,7 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
   std::vector<ps::Spectrum> primaries;
   for (size_t i = 0; i < cmd.primaries.size(); ++i)
     primaries.push_back(parse_option(cmd.primaries[i], "--primaries[" + std::to_string(i) + "]"));
+  ps::check_output_file(cmd.output, "--output");  // again, now that the scene and csv: inputs are read
   const ps::LightDesignResult result =
       ps::design_light(a, b, cmd.hide ? ps::LightGoal::Hide : ps::LightGoal::Reveal, reference, primaries, options);
   ps::write_spectrum_csv(cmd.output, result.light, "relative_spd");
@@ -236,6 +238,7 @@ int run_tabulate(const TabulateCommand& cmd) {
   if (!(cmd.step_nm > 0.0) || !(cmd.from_nm < cmd.to_nm) || (cmd.to_nm - cmd.from_nm) / cmd.step_nm > 1e6)
     throw ps::InputError("--from/--to/--step", "need from < to and a step > 0 giving at most 1e6 samples");
   const ps::Spectrum s = parse_option(cmd.spectrum, "--spectrum");
+  ps::check_output_file(cmd.output, "--output");  // again, now that a csv: input is read
   std::vector<double> lambda;
   for (double l = cmd.from_nm; l < cmd.to_nm - 1e-9; l += cmd.step_nm) lambda.push_back(l);
   lambda.push_back(cmd.to_nm);
@@ -248,6 +251,7 @@ int run_tabulate(const TabulateCommand& cmd) {
 int run_weights(const WeightsCommand& cmd, const CommonOptions& common) {
   const ps::ColourSetting colour = colour_setting(common);
   const ps::Spectrum light = parse_option(cmd.light, "--light");
+  ps::check_output_file(cmd.output, "--output");  // again, now that a csv: input is read
   const Eigen::Matrix<double, 3, Eigen::Dynamic> w =
       ps::relight_weights(ps::ColorMatching::get(colour.observer), light, colour.bins);
   std::string text = "lo_nm,hi_nm,X,Y,Z\n";

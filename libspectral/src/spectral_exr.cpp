@@ -51,6 +51,7 @@
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/light_spectrum.h"
+#include "prizma/spectral/output_group.h"
 #include "prizma/spectral/tool_main.h"
 #include "bispectral_exr.h"
 #include "coefficients_exr.h"
@@ -618,7 +619,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
       }
       throw RuntimeError(p + ": cannot write OpenEXR file: " + e.what());
     }
-  });
+  }, opts.group);
 }
 
 // ---------------------------------------------------------------------------------------------

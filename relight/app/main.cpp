@@ -119,10 +119,11 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
 
 // session.save(), with what libpng prints on stderr (e.g. "libpng error: No IDATs written into
 // file" when memory runs out) made part of the one error line, and running out of memory named.
-void save_one_line(relight::RelightSession& session, const std::string& output, bool quiet) {
+void save_one_line(relight::RelightSession& session, const std::string& output, bool quiet,
+                   spectral::OutputGroup* group) {
   spectral::StderrCapture capture;
   try {
-    spectral::allocating("writing " + output, [&] { session.save(output); });
+    spectral::allocating("writing " + output, [&] { session.save(output, "--output", group); });
   } catch (const InputError& e) {
     throw InputError(e.input(), e.reason() + spectral::library_said("libpng", capture.finish(), e.what()));
   } catch (const spectral::RuntimeError& e) {
@@ -216,15 +217,18 @@ int run(const CliOptions& o) {
       outputs.emplace_back(batch[i].file, o.batch + ": outputs[" + std::to_string(i) + "].file");
     spectral::check_distinct_outputs(outputs);
   }
+  // The batch's images and -o appear together or not at all (a full disk on the last leaves none).
+  spectral::OutputGroup outputs;
   if (!batch.empty()) {
-    relight::run_batch(session, batch, o.verbose ? &std::cerr : nullptr);
+    relight::run_batch(session, batch, o.verbose ? &std::cerr : nullptr, &outputs);
     session.apply(cli_settings);
   }
   if (!o.output.empty()) {
     const double ms = spectral::allocating("relighting", [&] { return session.relight(); });
-    save_one_line(session, o.output, o.quiet);
+    save_one_line(session, o.output, o.quiet, &outputs);
     if (o.verbose) std::cerr << "prizma-relight: wrote " << o.output << " (relit in " << ms << " ms)\n";
   }
+  outputs.commit();
   if (o.show && !o.interactive) {
     const relight::XyzImage& img = session.xyz();
     const std::vector<float> rgb = relight::to_display(img, session.display());
@@ -264,15 +268,11 @@ int run(const CliOptions& o) {
 // coefficients to a spectral EXR (docs/relight.md, "Compressed transport").
 int run_compress(const std::string& input, const std::string& output, const relight::CompressFileOptions& options,
                  bool quiet) {
-  spectral::require_regular_file(input, "an OpenEXR file");
+  spectral::require_regular_file(input, "an OpenEXR file");  // an input: the output may not replace it
   spectral::check_output_file(output, "--output");
   std::filesystem::path out_path(output);
   if (out_path.extension() != ".exr") {
     throw InputError("--output", output + ": the compressed file is a spectral EXR: give it the extension .exr");
-  }
-  std::error_code ec;
-  if (std::filesystem::equivalent(input, output, ec)) {
-    throw InputError("--output", output + " is the input file: write the compressed file beside it");
   }
   const relight::CompressedTransport t = spectral::allocating("compressing " + input, [&] {
     return relight::compress_spectral_exr(input, output, options);

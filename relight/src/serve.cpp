@@ -362,7 +362,7 @@ void RelightServer::Impl::routes() {
     const std::lock_guard lock(mutex);
     apply_state(req, {"file"});
     const fs::path path = opts.save_dir / name;
-    session.save(path);
+    session.save(path, "file");
     send_json(res, {{"file", name}, {"path", path.string()}, {"state", state_string(session.settings(), session)}});
   }));
 }

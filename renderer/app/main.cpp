@@ -21,6 +21,8 @@
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
+#include "prizma/spectral/output_group.h"
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/tool_main.h"
 
@@ -84,8 +86,8 @@ struct Options {
 };
 
 // Refuses before any work outputs that cannot be written (spectral::check_output_file: a folder, a
-// device, a FIFO, a missing or read-only folder, …), a preview in a format that cannot be written,
-// and a preview that is the same file as the output.
+// device, a FIFO, a missing or read-only folder, a file the run reads, …), a preview in a format that
+// cannot be written, and a preview that is the same file as the output.
 void check_outputs(const std::filesystem::path& output, const std::string& output_input, const std::string& preview) {
   std::vector<std::pair<std::filesystem::path, std::string>> outputs{{output, output_input}};
   if (!preview.empty()) {
@@ -131,18 +133,23 @@ class ProgressBar {
   bool m_drawn = false;
 };
 
+// The EXR and the preview appear together or not at all (a full disk on the preview leaves neither).
 void write_outputs(const spectral::SpectralImage& image, const std::filesystem::path& output, bool half,
                    const std::string& preview, const std::vector<render::Light>& lights,
                    const std::filesystem::path& spectrum_base_dir, int threads) {
+  spectral::OutputGroup outputs;
   spectral::ExrWriteOptions wo;
   wo.pixel_type = half ? spectral::ExrPixelType::Half : spectral::ExrPixelType::Float;
   wo.threads = threads;  // --threads holds for OpenEXR's encoding too
+  wo.group = &outputs;
   spectral::write_spectral_exr(output, image, wo);
   if (!preview.empty()) {
     render::PreviewOptions po;
     po.spectrum_base_dir = spectrum_base_dir;
+    po.group = &outputs;
     render::write_preview(preview, image, lights, po);
   }
+  outputs.commit();
 }
 
 int merge_main(int argc, char** argv) {
@@ -170,6 +177,10 @@ int merge_main(int argc, char** argv) {
   std::optional<tbb::global_control> thread_limit;
   if (threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
   return spectral::run_tool(kProgram, [&] {
+    check_outputs(output, "-o", preview);
+    // Then again with the shards recorded as inputs (require_regular_file): -o or --preview naming
+    // one is refused before any shard is read.
+    for (const auto& f : inputs) spectral::require_regular_file(f, "an OpenEXR file");
     check_outputs(output, "-o", preview);
     std::vector<spectral::SpectralImage> shards;
     spectral::ExrReadOptions read_options;
@@ -293,6 +304,8 @@ int main(int argc, char** argv) {
         throw InputError("-D", "not with --resume (the partial file's scene is continued as it was rendered)");
       render::ResumeRequest req{o.resume, o.scene, given, o.spp, !o.no_verify};
       render::ResumePlan plan = render::plan_resume(req);
+      // In place: the output (by default the file itself) replaces it only once complete.
+      spectral::allow_in_place_update(o.resume, {"-o", "--resume"});
       std::error_code ec;
       if (plan.complete && (o.output.empty() || std::filesystem::equivalent(o.output, o.resume, ec))) {
         if (!o.quiet)

@@ -92,7 +92,8 @@ def expect_unchanged(path, before):
 
 
 def expect_no_temporaries(folder):
-    left = [f for f in os.listdir(folder) if f.startswith(".prizma-tmp-")]
+    """No temporary (.prizma-tmp-*) and no kept link to a replaced file (.prizma-old-*) in folder."""
+    left = [f for f in os.listdir(folder) if f.startswith((".prizma-tmp-", ".prizma-old-"))]
     if left:
         fail(f"{folder}: temporaries left behind: {left}")
 

@@ -11,6 +11,8 @@
 
 namespace prizma::spectral {
 
+class OutputGroup;
+
 struct SpectralExrInfo {
   std::string lights_json;       // prizma:lights (JSON array of {name, direction, angularSizeDeg, spectrum})
   std::int64_t samples = 0;      // prizma:samples, samples per pixel in this file
@@ -103,6 +105,9 @@ struct ExrWriteOptions {
   // the calling thread (prizma-render --threads 1); n = at most n chunks in flight. The file is the
   // same byte for byte whatever the count.
   int threads = 0;
+  // Written into this group of the run's outputs (output_group.h), to appear at its commit(); null:
+  // in place when this call returns.
+  OutputGroup* group = nullptr;
 };
 
 // Writes atomically (temporary file in the same folder, then rename): a failure never leaves a partial
