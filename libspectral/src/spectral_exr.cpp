@@ -194,6 +194,16 @@ void check_finite(const std::vector<float>& values, int width, int bins, const s
   }
 }
 
+// prizma:lights as the reader takes it: JSON nested at most kMaxJsonDepth deep. The writer checks
+// the same, so that no file is written that the reader then refuses. Null JSON for empty text.
+nlohmann::json parse_lights_json(const std::string& text, const std::string& path) {
+  if (text.empty()) return {};
+  check_json_depth(text, path + ": " + kAttrLights);
+  nlohmann::json j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) throw InputError(path, std::string(kAttrLights) + " is not valid JSON");
+  return j;
+}
+
 std::string default_lights_json(const SpectralImage& image) {
   nlohmann::json arr = nlohmann::json::array();
   for (const auto& l : image.lights) arr.push_back({{"name", l.name}});
@@ -414,6 +424,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
                             " is empty");
   }
   if (image.lights.empty()) throw InputError(p, "the image has no light layers");
+  parse_lights_json(image.info.lights_json, p);
   const int bins = image.bins.size();
   const std::size_t expected = image.pixel_count() * static_cast<std::size_t>(bins);
   // Compact: spectral-basis coefficients only, no bins (prizma-relight compress --compact).
@@ -970,12 +981,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     if (const auto* s = find_string_attr(header, kAttrRenderOptions)) info.render_options = *s;
     info.samples = int_attr(header, kAttrSamples, p);
     info.seed = read_seed(header, kAttrSeed, p);
-    nlohmann::json lights_json;
-    if (!info.lights_json.empty()) {
-      check_json_depth(info.lights_json, p + ": " + kAttrLights);
-      lights_json = nlohmann::json::parse(info.lights_json, nullptr, /*allow_exceptions=*/false);
-      if (lights_json.is_discarded()) throw InputError(p, std::string(kAttrLights) + " is not valid JSON");
-    }
+    const nlohmann::json lights_json = parse_lights_json(info.lights_json, p);
 
     // Light layers: named layers (not variance) if any, else the top-level layer.
     auto is_variance = [](const std::string& layer) {

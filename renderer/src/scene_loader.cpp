@@ -931,15 +931,12 @@ std::uint64_t scene_seed_override(const std::string& text, const std::string& op
   return read_seed(Reader("", {}), j, option);
 }
 
-Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverride>& overrides) {
-  const std::string file = path.string();
-  spectral::require_regular_file(path, "a scene file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(file, "cannot open scene file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+namespace {
 
+// The scene in `text`, named `file` in messages; `path` is its source (relative paths resolve in its
+// folder; the default output is beside it).
+Scene scene_from_text(const std::string& text, const std::string& file, const std::filesystem::path& path,
+                      const std::vector<SceneOverride>& overrides) {
   json root = parse_json(text, file);
   std::vector<std::string> overridden;
   if (!overrides.empty() && !root.is_object()) throw InputError(file, "must be an object (the scene) for -D");
@@ -1039,6 +1036,23 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverr
     if (l.environment_map) h.add(l.environment_map->values().data(), l.environment_map->values().size() * sizeof(float));
   scene.hash = h.hex();
   return scene;
+}
+
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverride>& overrides) {
+  const std::string file = path.string();
+  spectral::require_regular_file(path, "a scene file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(file, "cannot open scene file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return scene_from_text(buffer.str(), file, path, overrides);
+}
+
+Scene load_scene_text(const std::string& text, const std::string& input, const std::filesystem::path& base_dir,
+                      const std::vector<SceneOverride>& overrides) {
+  return scene_from_text(text, input, base_dir / input, overrides);
 }
 
 }  // namespace prizma::render

@@ -819,12 +819,19 @@ TEST_F(SpectralExr, ReadsPlainMultiLayerFileAsLights) {
   EXPECT_EQ(img.lights[1].data, (std::vector<float>{1, 2}));
 }
 
+// The reader refuses prizma:lights that is not JSON, and the writer refuses to write it (the Python
+// module's write stored text its own read then refused).
 TEST_F(SpectralExr, RefusesInvalidLightsJson) {
   SpectralImage img = make_image(1, 1, BinLayout::linear(400, 700, 2), {"a"});
+  const fs::path valid = file("valid.exr");
+  write_spectral_exr(valid, img);
+  const fs::path p = rewrite_header(valid, file("json.exr"), [](Imf::Header& h) {
+    h.insert("prizma:lights", Imf::StringAttribute("[{not json"));
+  });
+  EXPECT_NE(read_error(p).find("prizma:lights is not valid JSON"), std::string::npos) << read_error(p);
   img.info.lights_json = "[{not json";
-  const fs::path p = file("json.exr");
-  write_spectral_exr(p, img);
-  EXPECT_NE(read_error(p).find("prizma:lights"), std::string::npos);
+  EXPECT_THROW(write_spectral_exr(file("refused.exr"), img), InputError);
+  EXPECT_FALSE(fs::exists(file("refused.exr")));
 }
 
 TEST_F(SpectralExr, ReadsDataWindowNotAtOrigin) {
@@ -929,11 +936,16 @@ TEST_F(SpectralExr, RefusesNonRegularFiles) {
 // issue 11: a deeply nested prizma:lights record is refused (nlohmann recurses on such values).
 TEST_F(SpectralExr, RefusesDeeplyNestedLightsJson) {
   SpectralImage img = make_image(1, 1, BinLayout::linear(400, 700, 2), {"a"});
-  img.info.lights_json = std::string(70000, '[') + std::string(70000, ']');
-  const fs::path p = file("deep.exr");
-  write_spectral_exr(p, img);
+  const std::string deep = std::string(70000, '[') + std::string(70000, ']');
+  const fs::path valid = file("shallow.exr");
+  write_spectral_exr(valid, img);
+  const fs::path p = rewrite_header(valid, file("deep.exr"), [&](Imf::Header& h) {
+    h.insert("prizma:lights", Imf::StringAttribute(deep));
+  });
   const std::string err = read_error(p);
   EXPECT_NE(err.find("prizma:lights: JSON nested deeper than"), std::string::npos) << err;
+  img.info.lights_json = deep;
+  EXPECT_THROW(write_spectral_exr(file("refused.exr"), img), InputError);
 }
 
 // Compression (docs/spectral-exr.md): at most 1 MiB of pixel data (all channels as stored) is
