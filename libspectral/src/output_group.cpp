@@ -64,6 +64,33 @@ void OutputGroup::write(const fs::path& path, const std::function<void(AtomicOut
   }
 }
 
+std::string OutputGroup::put_back(std::size_t count) {
+  std::vector<std::string> undone, kept;
+  for (std::size_t j = count; j-- > 0;) {  // last first
+    File& p = m_files[j];
+    const std::string name = p.temporary.destination.string();
+    if (!p.temporary.existed) {
+      if (::unlink(p.temporary.target.c_str()) == 0) {
+        undone.push_back(name + " was removed again");
+      } else {
+        kept.push_back(name + " could not be removed again (" + std::strerror(errno) + ")");
+      }
+    } else if (p.backup.empty()) {
+      kept.push_back(name + " could not be put back (no link to the old file could be made: " + p.backup_error + ")");
+    } else if (::rename(p.backup.c_str(), p.temporary.target.c_str()) == 0) {
+      undone.push_back(name + " was put back as it was");
+    } else {
+      kept.push_back(name + " could not be put back (" + std::strerror(errno) + "); the old file is " +
+                     detail::quoted_path(p.backup));
+      p.backup.clear();  // kept: it holds the old file
+    }
+    p.placed = false;
+  }
+  std::string note = listed(undone);
+  if (!kept.empty()) note += (note.empty() ? "" : "; ") + listed(kept) + ": it holds this run's output";
+  return note;
+}
+
 void OutputGroup::commit() {
   for (std::size_t i = 0; i < m_files.size(); ++i) {
     File& f = m_files[i];
@@ -82,31 +109,8 @@ void OutputGroup::commit() {
     }
     const std::string reason = std::strerror(errno);
     remove_quietly(f.backup);
-    // Undo, last first: the old file back from its link, a new one removed.
-    std::vector<std::string> undone, kept;
-    for (std::size_t j = i; j-- > 0;) {
-      File& p = m_files[j];
-      const std::string name = p.temporary.destination.string();
-      if (!p.temporary.existed) {
-        if (::unlink(p.temporary.target.c_str()) == 0) {
-          undone.push_back(name + " was removed again");
-        } else {
-          kept.push_back(name + " could not be removed again (" + std::strerror(errno) + ")");
-        }
-      } else if (p.backup.empty()) {
-        kept.push_back(name + " could not be put back (no link to the old file could be made: " + p.backup_error + ")");
-      } else if (::rename(p.backup.c_str(), p.temporary.target.c_str()) == 0) {
-        undone.push_back(name + " was put back as it was");
-      } else {
-        kept.push_back(name + " could not be put back (" + std::strerror(errno) + "); the old file is " +
-                       detail::quoted_path(p.backup));
-        p.backup.clear();  // keep it: it holds the old file
-      }
-      p.placed = false;
-    }
     std::string note = t.existed ? "the existing file is unchanged" : "";
-    for (const std::string& part : {listed(undone), kept.empty() ? "" : listed(kept) + ": it holds this run's output"})
-      if (!part.empty()) note += (note.empty() ? "" : "; ") + part;
+    if (const std::string undone = put_back(i); !undone.empty()) note += (note.empty() ? "" : "; ") + undone;
     RuntimeError error = detail::write_failure(
         t.destination, "cannot rename " + detail::quoted_path(t.temporary) + " into place (" + reason + ")", note);
     for (std::size_t j = i; j < m_files.size(); ++j) remove_quietly(m_files[j].temporary.temporary);

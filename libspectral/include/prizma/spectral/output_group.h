@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "prizma/spectral/atomic_file.h"
@@ -38,6 +39,9 @@ class OutputGroup {
  private:
   struct File;
   void discard() noexcept;
+  // Undoes the renames of the first `count` files (the old file back from its link, a new one
+  // removed); says what was undone and what could not be.
+  std::string put_back(std::size_t count);
   std::vector<File> m_files;
 };
 
