@@ -174,6 +174,7 @@ int run_metamer(const MetamerCommand& cmd, const CommonOptions& common) {
   const ps::Spectrum albedo = parse_option(cmd.albedo, "--albedo");
   const ps::Spectrum match = parse_option(cmd.match_light, "--match-light");
   const ps::Spectrum split = parse_option(cmd.split_light, "--split-light");
+  ps::check_output_file(cmd.output, "--output");  // again, now that the csv: inputs are read
   const ps::MetamerResult result = ps::design_metamer(albedo, match, split, options);
   ps::write_spectrum_csv(cmd.output, result.reflectance, "reflectance");
 
@@ -213,6 +214,7 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
   std::vector<ps::Spectrum> primaries;
   for (size_t i = 0; i < cmd.primaries.size(); ++i)
     primaries.push_back(parse_option(cmd.primaries[i], "--primaries[" + std::to_string(i) + "]"));
+  ps::check_output_file(cmd.output, "--output");  // again, now that the scene and csv: inputs are read
   const ps::LightDesignResult result =
       ps::design_light(a, b, cmd.hide ? ps::LightGoal::Hide : ps::LightGoal::Reveal, reference, primaries, options);
   ps::write_spectrum_csv(cmd.output, result.light, "relative_spd");
@@ -236,6 +238,7 @@ int run_tabulate(const TabulateCommand& cmd) {
   if (!(cmd.step_nm > 0.0) || !(cmd.from_nm < cmd.to_nm) || (cmd.to_nm - cmd.from_nm) / cmd.step_nm > 1e6)
     throw ps::InputError("--from/--to/--step", "need from < to and a step > 0 giving at most 1e6 samples");
   const ps::Spectrum s = parse_option(cmd.spectrum, "--spectrum");
+  ps::check_output_file(cmd.output, "--output");  // again, now that a csv: input is read
   std::vector<double> lambda;
   for (double l = cmd.from_nm; l < cmd.to_nm - 1e-9; l += cmd.step_nm) lambda.push_back(l);
   lambda.push_back(cmd.to_nm);
@@ -248,6 +251,7 @@ int run_tabulate(const TabulateCommand& cmd) {
 int run_weights(const WeightsCommand& cmd, const CommonOptions& common) {
   const ps::ColourSetting colour = colour_setting(common);
   const ps::Spectrum light = parse_option(cmd.light, "--light");
+  ps::check_output_file(cmd.output, "--output");  // again, now that a csv: input is read
   const Eigen::Matrix<double, 3, Eigen::Dynamic> w =
       ps::relight_weights(ps::ColorMatching::get(colour.observer), light, colour.bins);
   std::string text = "lo_nm,hi_nm,X,Y,Z\n";
@@ -306,7 +310,7 @@ int main(int argc, char** argv) {
   sub_metamer->add_option("--albedo", metamer.albedo, "the reflectance to match")->required();
   sub_metamer->add_option("--match-light", metamer.match_light, "light under which both look the same")->required();
   sub_metamer->add_option("--split-light", metamer.split_light, "light under which they should differ most")->required();
-  sub_metamer->add_option("-o,--output", metamer.output, "output CSV (nm, reflectance)")->required();
+  sub_metamer->add_option("-o,--output", metamer.output, "output CSV (nm, reflectance)")->required()->check(ps::non_empty_path());
   sub_metamer->add_option("--basis", metamer.basis, "number of B-spline basis functions (smoothness)")
       ->capture_default_str()->check(CLI::Range(6, 200));
   sub_metamer->add_option("--min", metamer.min_value, "lower bound of the reflectance")->capture_default_str();
@@ -317,7 +321,7 @@ int main(int argc, char** argv) {
       "light", "design a light (same luminance as --reference) that hides or reveals the difference of two albedos");
   sub_light->add_option("--albedo-a", light.albedo_a, "first albedo spectrum");
   sub_light->add_option("--albedo-b", light.albedo_b, "second albedo spectrum");
-  sub_light->add_option("--scene", light.scene, "scene JSON to read materials' albedos from");
+  sub_light->add_option("--scene", light.scene, "scene JSON to read materials' albedos from")->check(ps::non_empty_path());
   sub_light->add_option("--material-a", light.material_a, "first material's name (or index) in --scene");
   sub_light->add_option("--material-b", light.material_b, "second material's name (or index) in --scene");
   sub_light->add_flag("--hide", light.hide, "make the two look the same (dE00 -> 0)");
@@ -330,7 +334,9 @@ int main(int argc, char** argv) {
   sub_light->add_option("--max-power-ratio", light.max_power_ratio,
                         "radiant power at most this many times the reference's at equal luminance (0: no limit)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
-  sub_light->add_option("-o,--output", light.output, "output CSV (nm, relative spectral power)")->required();
+  sub_light->add_option("-o,--output", light.output, "output CSV (nm, relative spectral power)")
+      ->required()
+      ->check(ps::non_empty_path());
 
   DeltaECommand delta;
   CLI::App* sub_delta = app.add_subcommand(
@@ -343,7 +349,7 @@ int main(int argc, char** argv) {
   CLI::App* sub_weights = app.add_subcommand(
       "weights", "write the relighter's X,Y,Z weights per bin for --light (white-normalised: sum of Y = 1)");
   sub_weights->add_option("--light", weights.light, "light spectrum")->capture_default_str();
-  sub_weights->add_option("-o,--output", weights.output, "output CSV (lo_nm, hi_nm, X, Y, Z)")->required();
+  sub_weights->add_option("-o,--output", weights.output, "output CSV (lo_nm, hi_nm, X, Y, Z)")->required()->check(ps::non_empty_path());
 
   TabulateCommand tabulate;
   CLI::App* sub_tabulate = app.add_subcommand("tabulate", "write a spectrum spec as a CSV table (for scripts and plots)");
@@ -351,7 +357,7 @@ int main(int argc, char** argv) {
   sub_tabulate->add_option("--from", tabulate.from_nm, "first wavelength (nm)")->capture_default_str();
   sub_tabulate->add_option("--to", tabulate.to_nm, "last wavelength (nm)")->capture_default_str();
   sub_tabulate->add_option("--step", tabulate.step_nm, "step (nm)")->capture_default_str();
-  sub_tabulate->add_option("-o,--output", tabulate.output, "output CSV")->required();
+  sub_tabulate->add_option("-o,--output", tabulate.output, "output CSV")->required()->check(ps::non_empty_path());
 
   if (const int code = ps::parse_command_line(app, argc, argv); code >= 0) return code;
   return ps::run_tool(program, [&]() {

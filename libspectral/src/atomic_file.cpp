@@ -7,16 +7,20 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <climits>
 #include <cstring>
 #include <map>
+#include <set>
 #include <string>
 #include <system_error>
 #include <tuple>
 
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
+#include "atomic_file_detail.h"
 
 namespace prizma::spectral {
 namespace {
@@ -152,11 +156,11 @@ Resolved resolve(const fs::path& path) {
   return r;
 }
 
-// ".prizma-tmp-<pid>-<n>-<name>", keeping the tail of the name (its extension) when the whole would
-// be longer than the file system allows.
-std::string temporary_name(const std::string& name, std::size_t limit) {
-  const std::string prefix =
-      ".prizma-tmp-" + std::to_string(::getpid()) + "-" + std::to_string(g_counter.fetch_add(1)) + "-";
+// "<kind><pid>-<n>-<name>" (kind ".prizma-tmp-" for temporaries, ".prizma-old-" for the links an
+// OutputGroup keeps to the files it replaces), keeping the tail of the name (its extension) when the
+// whole would be longer than the file system allows.
+std::string temporary_name(const std::string& name, std::size_t limit, const char* kind = ".prizma-tmp-") {
+  const std::string prefix = kind + std::to_string(::getpid()) + "-" + std::to_string(g_counter.fetch_add(1)) + "-";
   if (prefix.size() + name.size() <= limit) return prefix + name;
   std::size_t cut = name.size() - (limit - prefix.size());
   // Do not cut a UTF-8 sequence in two.
@@ -169,10 +173,31 @@ void remove_quietly(const fs::path& p) {
   fs::remove(p, ec);
 }
 
+// "a scene file" → "the scene file".
+std::string definite(const std::string& kind) {
+  for (const std::string_view article : {"a ", "an "})
+    if (kind.rfind(article, 0) == 0) return "the " + kind.substr(article.size());
+  return kind;
+}
+
+// Why the output `path` (option `input`, resolved to `target`) may not be written: it is an input
+// the run has read (InputRecording), and not one `input` may update in place. "" when it may.
+// `input` empty: any output allowed to update the input in place may (write time, after the check).
+std::string replaces_input(const OutputTarget& target, const fs::path& path, const std::string& input) {
+  if (!target.exists) return {};
+  const std::optional<RecordedInput> in = recorded_input(target.device, target.inode);
+  if (!in) return {};
+  const auto& allowed = in->replaced_by;
+  if (input.empty() ? !allowed.empty() : std::find(allowed.begin(), allowed.end(), input) != allowed.end()) return {};
+  return quoted(path) + " would replace " + quoted(in->path) + ", " + definite(in->kind) +
+         " this run reads (an output never replaces an input)";
+}
+
 }  // namespace
 
 OutputTarget check_output_file(const fs::path& path, const std::string& input) {
   Resolved r = resolve(path);
+  if (r.problem.empty()) r.problem = replaces_input(r.target, path, input);
   if (!r.problem.empty()) throw InputError(input, r.problem);
   return r.target;
 }
@@ -298,19 +323,28 @@ std::string AtomicOutput::error() const {
 }
 
 // ---------------------------------------------------------------------------------------------
-// write_atomically
+// write_atomically: a complete temporary (detail::write_temporary), then detail::put_in_place
 
-void write_atomically(const fs::path& path, const std::function<void(AtomicOutput& out)>& write) {
+namespace detail {
+
+RuntimeError write_failure(const fs::path& path, const std::string& reason, const std::string& note) {
+  return RuntimeError(path.string() + ": cannot write: " + reason + (note.empty() ? "" : " (" + note + ")"));
+}
+
+CompleteTemporary write_temporary(const fs::path& path, const std::function<void(AtomicOutput& out)>& write,
+                                  const std::string& also_unwritten) {
   const Resolved r = resolve(path);
   if (!r.problem.empty()) {
     if (r.folder_problem) throw RuntimeError(path.string() + ": cannot write: " + r.problem);
     throw InputError(path.string(), r.problem);
   }
+  // The writers that skip check_output_file still never replace an input (docs/errors.md).
+  if (const std::string problem = replaces_input(r.target, path, {}); !problem.empty())
+    throw InputError(path.string(), problem);
   const bool existed = r.target.exists;
-  const auto failure = [&](const std::string& reason) {
-    return RuntimeError(path.string() + ": cannot write: " + reason +
-                        (existed ? " (the existing file is unchanged)" : ""));
-  };
+  std::string note = existed ? "the existing file is unchanged" : "";
+  if (!also_unwritten.empty()) note += (note.empty() ? "" : "; ") + also_unwritten;
+  const auto failure = [&](const std::string& reason) { return write_failure(path, reason, note); };
 
   const fs::path tmp = r.folder / temporary_name(r.target.file.filename().string(), name_max(r.folder));
   const int fd = ::open(tmp.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
@@ -365,23 +399,40 @@ void write_atomically(const fs::path& path, const std::function<void(AtomicOutpu
     abandon();
     throw failure(problem);
   }
+  return {path, r.target.file, r.folder, tmp, existed};
+}
 
-  if (::rename(tmp.c_str(), r.target.file.c_str()) != 0) {
+std::string backup_name(const CompleteTemporary& t) {
+  return temporary_name(t.target.filename().string(), name_max(t.folder), ".prizma-old-");
+}
+
+std::string flush_folder(const fs::path& folder) {
+  const int dfd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd < 0) return {};
+  const int rc = ::fsync(dfd);
+  const int err = errno;
+  (void)::close(dfd);
+  // File systems that cannot sync a folder say EINVAL (or ENOTSUP, EROFS): nothing to flush.
+  if (rc != 0 && err != EINVAL && err != ENOTSUP && err != EROFS) return errno_text(err);
+  return {};
+}
+
+std::string quoted_path(const fs::path& p) { return quoted(p); }
+
+}  // namespace detail
+
+void write_atomically(const fs::path& path, const std::function<void(AtomicOutput& out)>& write) {
+  const detail::CompleteTemporary t = detail::write_temporary(path, write, {});
+  if (::rename(t.temporary.c_str(), t.target.c_str()) != 0) {
     const std::string reason = errno_text(errno);
-    abandon();
-    throw failure("cannot rename " + quoted(tmp) + " into place (" + reason + ")");
+    remove_quietly(t.temporary);
+    throw detail::write_failure(path, "cannot rename " + quoted(t.temporary) + " into place (" + reason + ")",
+                                t.existed ? "the existing file is unchanged" : "");
   }
-
-  // The rename itself on disk: fsync the folder (file systems that cannot sync a folder say EINVAL).
-  const int dfd = ::open(r.folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    const int rc = ::fsync(dfd);
-    const int err = errno;
-    (void)::close(dfd);
-    if (rc != 0 && err != EINVAL && err != ENOTSUP && err != EROFS) {
-      throw RuntimeError(path.string() + ": written, but its folder " + quoted(r.folder) +
-                         " could not be flushed to disk (" + errno_text(err) + ")");
-    }
+  // The rename itself on disk.
+  if (const std::string err = detail::flush_folder(t.folder); !err.empty()) {
+    throw RuntimeError(path.string() + ": written, but its folder " + quoted(t.folder) +
+                       " could not be flushed to disk (" + err + ")");
   }
 }
 

@@ -4,10 +4,66 @@
 
 #include <cerrno>
 #include <cstring>
+#include <map>
+#include <mutex>
+#include <utility>
 
 #include "prizma/spectral/error.h"
 
 namespace prizma::spectral {
+namespace {
+
+// The record InputRecording keeps: by (device, inode), the first name each file was read under.
+struct InputRecord {
+  std::mutex mutex;
+  bool active = false;
+  std::map<std::pair<dev_t, ino_t>, RecordedInput> files;
+};
+
+InputRecord& input_record() {
+  static InputRecord record;
+  return record;
+}
+
+void record_input(const struct stat& st, const std::filesystem::path& path, std::string_view kind) {
+  InputRecord& r = input_record();
+  const std::lock_guard lock(r.mutex);
+  if (!r.active) return;
+  r.files.try_emplace({st.st_dev, st.st_ino}, RecordedInput{path, std::string(kind), {}});
+}
+
+}  // namespace
+
+InputRecording::InputRecording() {
+  InputRecord& r = input_record();
+  const std::lock_guard lock(r.mutex);
+  r.active = true;
+  r.files.clear();
+}
+
+InputRecording::~InputRecording() {
+  InputRecord& r = input_record();
+  const std::lock_guard lock(r.mutex);
+  r.active = false;
+  r.files.clear();
+}
+
+std::optional<RecordedInput> recorded_input(dev_t device, ino_t inode) {
+  InputRecord& r = input_record();
+  const std::lock_guard lock(r.mutex);
+  const auto it = r.files.find({device, inode});
+  if (it == r.files.end()) return std::nullopt;
+  return it->second;
+}
+
+void allow_in_place_update(const std::filesystem::path& path, const std::vector<std::string>& outputs) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return;
+  InputRecord& r = input_record();
+  const std::lock_guard lock(r.mutex);
+  const auto it = r.files.find({st.st_dev, st.st_ino});
+  if (it != r.files.end()) it->second.replaced_by = outputs;
+}
 
 void require_regular_file(const std::filesystem::path& path, std::string_view kind, const std::string& input) {
   const std::string name = input.empty() ? path.string() : input;
@@ -25,7 +81,10 @@ void require_regular_file(const std::filesystem::path& path, std::string_view ki
       default: throw InputError(name, std::string("cannot be accessed: ") + std::strerror(err));
     }
   }
-  if (S_ISREG(st.st_mode)) return;
+  if (S_ISREG(st.st_mode)) {
+    record_input(st, path, kind);
+    return;
+  }
   const std::string want(kind);
   if (S_ISDIR(st.st_mode)) throw InputError(name, "is a folder, not " + want);
   const char* what = S_ISFIFO(st.st_mode)  ? "a FIFO (named pipe)"

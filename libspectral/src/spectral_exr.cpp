@@ -51,6 +51,7 @@
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/light_spectrum.h"
+#include "prizma/spectral/output_group.h"
 #include "prizma/spectral/tool_main.h"
 #include "bispectral_exr.h"
 #include "coefficients_exr.h"
@@ -204,6 +205,16 @@ void put_int_or_string(Imf::Header& header, const char* name, std::int64_t v) {
     header.insert(name, Imf::IntAttribute(static_cast<int>(v)));
   } else {
     header.insert(name, Imf::StringAttribute(std::to_string(v)));
+  }
+}
+
+// prizma:seed: an int when it fits (every file before 0.3 too), else its unsigned decimal string.
+// (Files before 0.3 stored seeds ≥ 2^63 as negative numbers, the seed minus 2^64: read_seed.)
+void put_seed(Imf::Header& header, const char* name, std::uint64_t seed) {
+  if (seed <= static_cast<std::uint64_t>(std::numeric_limits<int>::max())) {
+    header.insert(name, Imf::IntAttribute(static_cast<int>(seed)));
+  } else {
+    header.insert(name, Imf::StringAttribute(std::to_string(seed)));
   }
 }
 
@@ -527,7 +538,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   header.insert(kAttrLights, Imf::StringAttribute(light_records_json(
                                  info.light_records.empty() ? light_records_for(layer_names(image)) : info.light_records)));
   put_int_or_string(header, kAttrSamples, info.samples);
-  put_int_or_string(header, kAttrSeed, info.seed);
+  put_seed(header, kAttrSeed, info.seed);
   if (!info.sample_range.empty()) header.insert(kAttrSampleRange, Imf::StringAttribute(info.sample_range));
   if (!info.scene_hash.empty()) header.insert(kAttrSceneHash, Imf::StringAttribute(info.scene_hash));
   header.insert(kAttrVersion, Imf::StringAttribute(info.version.empty() ? prizma_version() : info.version));
@@ -599,7 +610,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
       }
       throw RuntimeError(p + ": cannot write OpenEXR file: " + e.what());
     }
-  });
+  }, opts.group);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -739,6 +750,28 @@ std::int64_t int_attr(const Imf::Header& h, const char* name, const std::string&
     return v;
   }
   return 0;
+}
+
+// prizma:seed as put_seed writes it. A negative value (an int or a string) is a file written before
+// 0.3, which stored the 64-bit seed as a signed number: seed − 2^64 for seeds from 2^63 on.
+std::uint64_t read_seed(const Imf::Header& h, const char* name, const std::string& path) {
+  if (const auto* a = h.findTypedAttribute<Imf::IntAttribute>(name)) {
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(a->value()));
+  }
+  const auto* s = find_string_attr(h, name);
+  if (s == nullptr) return 0;
+  const char* begin = s->data();
+  const char* end = s->data() + s->size();
+  if (!s->empty() && s->front() == '-') {
+    std::int64_t v = 0;
+    const auto res = std::from_chars(begin, end, v);
+    if (res.ec == std::errc() && res.ptr == end) return static_cast<std::uint64_t>(v);
+  } else {
+    std::uint64_t v = 0;
+    const auto res = std::from_chars(begin, end, v);
+    if (res.ec == std::errc() && res.ptr == end) return v;
+  }
+  throw InputError(path, std::string(name) + ": \"" + *s + "\" is not a 64-bit seed");
 }
 
 std::string describe_lambdas(const std::vector<double>& l) {
@@ -927,7 +960,7 @@ SpectralImage read_spectral_exr(const fs::path& path, const ExrReadOptions& opts
     if (const auto* s = find_string_attr(header, kAttrScenePath)) info.scene_path = *s;
     if (const auto* s = find_string_attr(header, kAttrRenderOptions)) info.render_options = *s;
     info.samples = int_attr(header, kAttrSamples, p);
-    info.seed = int_attr(header, kAttrSeed, p);
+    info.seed = read_seed(header, kAttrSeed, p);
 
     // Light layers: named layers (not variance) if any, else the top-level layer.
     auto is_variance = [](const std::string& layer) {

@@ -17,6 +17,7 @@
 #include <system_error>
 
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
 #include "prizma/spectral/stderr_capture.h"
 
 #ifndef PRIZMA_VERSION
@@ -199,6 +200,8 @@ int run_tool(const std::string& program, const std::function<int()>& body) {
   // A file-size limit (ulimit -f) makes a write fail with EFBIG, reported like any failed write,
   // instead of killing the process with SIGXFSZ.
   std::signal(SIGXFSZ, SIG_IGN);
+  // Every file the tool reads is recorded: no output of the run may replace one (input_file.h).
+  const InputRecording inputs;
   try {
     return check_standard_output(program, body());
   } catch (const InputError& e) {

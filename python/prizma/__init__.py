@@ -11,7 +11,6 @@ the tools print after ``<program>: error:``.
 
 import json as _json
 import os as _os
-import tempfile as _tempfile
 
 import numpy as _np
 
@@ -134,9 +133,12 @@ class Image:
         lights = attrs.pop("lights", None)
         attrs.pop("is_prizma", None)
         if isinstance(lights, str):
-            attrs["lights_json"] = lights
+            attrs["lights_json"] = lights  # the writer refuses text its reader would refuse
         elif lights:
-            attrs["lights_json"] = _json.dumps(lights, separators=(",", ":"))
+            try:  # strict JSON: NaN and infinities have no JSON form (Python would write NaN)
+                attrs["lights_json"] = _json.dumps(lights, separators=(",", ":"), allow_nan=False)
+            except (TypeError, ValueError) as e:
+                raise _input_error('attributes["lights"]', f"cannot be stored as JSON ({e})") from None
         return {"bin_edges_nm": self.bin_edges_nm, "lights": self.lights, "variance": self.variance,
                 "attributes": attrs, "reradiation": self.reradiation, "reradiation_pairs": self.reradiation_pairs}
 
@@ -166,8 +168,13 @@ class Image:
                 f"lights {list(self.lights)}>")
 
 
-def _path(p):
-    return _os.fspath(p)
+def _path(p, name="path"):
+    """A path argument (str, bytes or os.PathLike) as text; a NUL in it is refused as Python's
+    open() refuses it (an InputError, a ValueError), not cut short by the C++ side."""
+    p = _os.fsdecode(_os.fspath(p))
+    if "\0" in p:
+        raise _input_error(name, "embedded null byte")
+    return p
 
 
 def read(path, verify=True):
@@ -217,11 +224,11 @@ def relight(image, lights=None, exposure=0.0, cmf="1931-2", display="sRGB", colo
     The same code as prizma-relight computes it (RelightSession): for the same settings the array
     equals the tool's output file. The GIL is released while relighting.
     """
-    source = image._native() if isinstance(image, Image) else _path(image)
+    source = image._native() if isinstance(image, Image) else _path(image, "image")
     if colour_space is not None:
         display = display or "sRGB"
     return _prizma.relight(source, lights, float(exposure), str(cmf), display, colour_space, bool(adapt),
-                           bool(absolute), _path(config))
+                           bool(absolute), _path(config, "config"))
 
 
 def spectrum(spec, wavelengths_nm=None):
@@ -279,35 +286,23 @@ def render(scene, samples=None, threads=0, seed=None, width=None, height=None, b
 
     Ctrl-C (SIGINT) stops the render at once: KeyboardInterrupt is raised, with the passes completed
     so far as its ``image`` attribute (a valid render of fewer samples) when there were any. The
-    GIL is released while rendering.
+    GIL is released while rendering. A scene given as a dict is read from memory (no file is
+    written); errors name it ``scene``. Integer arguments are checked as the tools check their
+    options (``seed=-1``: ``InputError: seed: …``).
     """
     if isinstance(scene, dict):
-        folder = _path(base_dir) if base_dir is not None else _os.getcwd()
-        fd, tmp = _tempfile.mkstemp(prefix=".prizma-scene-", suffix=".json", dir=folder)
-        try:
-            with _os.fdopen(fd, "w", encoding="utf-8") as f:
-                _json.dump(scene, f)
-            return _render(tmp, samples, threads, seed, width, height, bins, variance, progress,
-                           samples_per_pass, False)
-        except InputError as e:
-            if not str(e).startswith(tmp):
-                raise
-            # Name the dict "scene", not the temporary file it went through.
-            err = InputError("scene" + str(e)[len(tmp):])
-            err.input = "scene" + e.input[len(tmp):] if e.input.startswith(tmp) else e.input
-            err.reason = e.reason
-            raise err from None
-        finally:
-            _os.unlink(tmp)
-    return _render(_path(scene), samples, threads, seed, width, height, bins, variance, progress,
-                   samples_per_pass, True)
+        folder = _path(base_dir, "base_dir") if base_dir is not None else _os.getcwd()
+        return _render(_json.dumps(scene), True, folder, samples, threads, seed, width, height, bins, variance,
+                       progress, samples_per_pass)
+    return _render(_path(scene, "scene"), False, "", samples, threads, seed, width, height, bins, variance,
+                   progress, samples_per_pass)
 
 
-def _render(path, samples, threads, seed, width, height, bins, variance, progress, samples_per_pass,
-            record_path):
+def _render(scene, scene_is_json, base_dir, samples, threads, seed, width, height, bins, variance, progress,
+            samples_per_pass):
     try:
-        native = _prizma.render(path, samples, int(threads), seed, width, height, bins, bool(variance),
-                                int(samples_per_pass), progress, record_path)
+        native = _prizma.render(scene, scene_is_json, base_dir, samples, threads, seed, width, height, bins,
+                                bool(variance), samples_per_pass, progress)
     except KeyboardInterrupt as e:
         partial = getattr(e, "_prizma_image", None)
         e.image = Image._from_native(partial) if partial is not None else None

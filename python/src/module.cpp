@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -22,7 +23,7 @@
 #include <new>
 #include <optional>
 #include <string>
-#include <thread>
+#include <system_error>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -45,36 +46,24 @@
 #include "prizma/spectral/spectrum.h"
 #include "prizma/spectral/spectrum_spec.h"
 #include "prizma/spectral/tool_main.h"
+#include "module_parts.h"
+#include "native_call.h"
 
 namespace py = pybind11;
 namespace spectral = prizma::spectral;
 namespace relight = prizma::relight;
 namespace render = prizma::render;
 using spectral::InputError;
+using prizma::python::take_vector;
+using prizma::python::WithoutGil;
 
-namespace {
+namespace prizma::python {
 
-// The exception types (owned by the module object; kept alive for the process).
-PyObject* g_input_error = nullptr;
-PyObject* g_runtime_failure = nullptr;
-
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-// A numpy array that owns `values` (moved, not copied): the array's base is a capsule that deletes
-// the vector when numpy lets go of it.
-template <typename T>
-py::array_t<T> take_vector(std::vector<T>&& values, std::vector<py::ssize_t> shape) {
-  auto* owner = new std::vector<T>(std::move(values));
-  py::capsule base(owner, [](void* p) { delete static_cast<std::vector<T>*>(p); });
-  return py::array_t<T>(std::move(shape), owner->data(), base);
+std::string integer_text(const py::handle& value, const std::string& name) {
+  if (!PyLong_Check(value.ptr()) || PyBool_Check(value.ptr()))
+    throw InputError(name, "must be an integer (got " + std::string(py::repr(value)) + ")");
+  return std::string(py::str(value));
 }
-
-// ---------------------------------------------------------------------------------------------
-// SpectralImage ↔ Python. The Python side is a plain dict (prizma.Image wraps it):
-//   width, height, bin_edges_nm (float64 n+1), lights {name: float32 H×W×n}, variance {name: …},
-//   attributes {samples, sample_range, seed, scene_hash, version, wavelength_sampling, scene_path,
-//               render_options, lights_json, is_prizma}
 
 py::dict image_to_py(spectral::SpectralImage&& image) {
   py::dict out;
@@ -117,6 +106,26 @@ py::dict image_to_py(spectral::SpectralImage&& image) {
   out["attributes"] = a;
   return out;
 }
+
+}  // namespace prizma::python
+
+using prizma::python::image_to_py;
+using prizma::python::integer_text;
+
+namespace {
+
+// The exception types (owned by the module object; kept alive for the process).
+PyObject* g_input_error = nullptr;
+PyObject* g_runtime_failure = nullptr;
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// ---------------------------------------------------------------------------------------------
+// SpectralImage ↔ Python. The Python side is a plain dict (prizma.Image wraps it):
+//   width, height, bin_edges_nm (float64 n+1), lights {name: float32 H×W×n}, variance {name: …},
+//   attributes {samples, sample_range, seed, scene_hash, version, wavelength_sampling, scene_path,
+//               render_options, lights_json, is_prizma}
 
 template <typename T>
 T attribute_or(const py::dict& attrs, const char* key, T fallback) {
@@ -219,7 +228,8 @@ spectral::SpectralImage image_from_py(const py::dict& d) {
   spectral::SpectralExrInfo& info = image.info;
   info.samples = attribute_or<std::int64_t>(attrs, "samples", 0);
   info.sample_range = attribute_or<std::string>(attrs, "sample_range", "");
-  info.seed = attribute_or<std::int64_t>(attrs, "seed", 0);
+  if (attrs.contains("seed") && !attrs["seed"].is_none())
+    info.seed = render::scene_seed_override(integer_text(attrs["seed"], "attributes[\"seed\"]"), "attributes[\"seed\"]");
   info.scene_hash = attribute_or<std::string>(attrs, "scene_hash", "");
   info.version = attribute_or<std::string>(attrs, "version", "");
   info.wavelength_sampling = attribute_or<std::string>(attrs, "wavelength_sampling", "");
@@ -237,7 +247,7 @@ spectral::SpectralImage image_from_py(const py::dict& d) {
 py::dict read_file(const std::string& path, bool verify) {
   spectral::SpectralImage image;
   {
-    py::gil_scoped_release release;
+    const WithoutGil released;
     spectral::ExrReadOptions opts;
     opts.verify_checksum = verify;
     opts.unverified_read = "prizma.read(path, verify=False)";
@@ -249,7 +259,7 @@ py::dict read_file(const std::string& path, bool verify) {
 void write_file(const std::string& path, const py::dict& image_dict, bool half) {
   spectral::check_output_file(path, "path");  // as the tools check -o: a missing folder is bad input
   spectral::SpectralImage image = image_from_py(image_dict);
-  py::gil_scoped_release release;
+  const WithoutGil released;
   spectral::ExrWriteOptions opts;
   opts.pixel_type = half ? spectral::ExrPixelType::Half : spectral::ExrPixelType::Float;
   spectral::write_spectral_exr(path, image, opts);
@@ -263,11 +273,11 @@ std::string checksum(const py::dict& image_dict) { return spectral::spectral_pix
 std::unique_ptr<relight::RelightSession> open_session(const py::object& source) {
   if (py::isinstance<py::dict>(source)) {
     spectral::SpectralImage image = image_from_py(source.cast<py::dict>());
-    py::gil_scoped_release release;
+    const WithoutGil released;
     return std::make_unique<relight::RelightSession>(std::move(image), "image");
   }
   const std::string path = source.cast<std::string>();
-  py::gil_scoped_release release;
+  const WithoutGil released;
   return std::make_unique<relight::RelightSession>(path);
 }
 
@@ -312,7 +322,7 @@ py::array_t<float> relight_image(const py::object& source, const py::object& lig
   const int w = session->image().width, h = session->image().height;
   std::vector<float> pixels;
   {
-    py::gil_scoped_release release;
+    const WithoutGil released;
     session->relight();
     const relight::XyzImage& xyz = session->xyz();
     // Exactly what write_output_image writes before quantisation: PNG/TIFF the display, clamped; EXR
@@ -456,7 +466,7 @@ py::dict metamer(const py::object& albedo, const py::object& match_light, const 
   const spectral::Spectrum sp = spectrum_from(split_light, "split light");
   spectral::MetamerResult r;
   {
-    py::gil_scoped_release release;
+    const WithoutGil released;
     r = spectral::design_metamer(a, m, sp, opts);
   }
   py::dict out;
@@ -483,7 +493,7 @@ py::dict design_light(const py::object& albedo_a, const py::object& albedo_b, co
   for (std::size_t i = 0; i < primaries.size(); ++i) prims.push_back(spectrum_from(primaries[i], "primaries[" + std::to_string(i) + "]"));
   spectral::LightDesignResult r;
   {
-    py::gil_scoped_release release;
+    const WithoutGil released;
     r = spectral::design_light(a, b, g, ref, prims, opts);
   }
   py::dict out;
@@ -492,137 +502,6 @@ py::dict design_light(const py::object& albedo_a, const py::object& albedo_b, co
   out["weights"] = take_vector(std::move(r.weights), {n_weights});
   out["delta_e"] = r.delta_e;
   out["delta_e_reference"] = r.delta_e_reference;
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Rendering: render() on a worker thread with the GIL released; the calling thread relays progress
-// to the Python callback and checks for signals (Ctrl-C) every 50 ms, setting the renderer's
-// cancellation flag when one arrives. render() then returns the passes completed so far.
-
-struct PythonError {  // a fetched Python exception (owned references), restored on the calling thread
-  PyObject *type = nullptr, *value = nullptr, *traceback = nullptr;
-  bool set() const { return type != nullptr; }
-  void fetch() { PyErr_Fetch(&type, &value, &traceback); }
-  void restore() {
-    PyErr_Restore(type, value, traceback);
-    type = value = traceback = nullptr;
-  }
-};
-
-py::dict render_scene(const std::string& scene_path, std::optional<std::int64_t> samples, int threads,
-                      std::optional<std::uint64_t> seed, std::optional<int> width, std::optional<int> height,
-                      const std::optional<std::string>& bins, bool variance, std::int64_t samples_per_pass,
-                      const py::object& progress, bool record_scene_path) {
-  render::Scene scene;
-  render::RenderOverrides given;
-  {
-    py::gil_scoped_release release;
-    scene = render::load_scene(scene_path);
-  }
-  if (width) given.width = static_cast<int>(render::scene_integer_override(std::to_string(*width), "camera.width", "width"));
-  if (height) given.height = static_cast<int>(render::scene_integer_override(std::to_string(*height), "camera.height", "height"));
-  given.seed = seed;
-  given.bins = bins;
-  given.variance = variance;
-  render::apply_overrides(scene, given, "");
-  auto& st = scene.settings;
-  if (samples) st.sample_end = render::SampleRange::starting_at(st.sample_begin, *samples, "samples").end;
-  if (threads < 0) throw InputError("threads", "must be ≥ 0 (0: all cores)");
-  if (samples_per_pass < 0) throw InputError("samples_per_pass", "must be ≥ 0 (0: automatic)");
-  if (threads > 0) st.threads = threads;
-  given.samples = render::SampleRange{st.sample_begin, st.sample_end};
-
-  std::atomic<bool> cancel{false};
-  std::mutex mutex;
-  std::condition_variable wake;
-  bool done = false;
-  std::vector<render::RenderProgress> reports;  // not yet relayed, in order
-  std::exception_ptr failure;
-  spectral::SpectralImage image;
-  render::RenderStats stats;
-  render::RenderCallbacks cb;
-  cb.cancel = &cancel;
-  cb.samples_per_pass = samples_per_pass;
-  cb.progress = [&](const render::RenderProgress& p) {
-    const std::lock_guard lock(mutex);
-    reports.push_back(p);
-    wake.notify_all();
-  };
-
-  PythonError pending;
-  bool interrupted_by_signal = false;
-  {
-    py::gil_scoped_release release;
-    std::thread worker([&] {
-      try {
-        image = render::render(scene, cb, &stats);
-      } catch (...) {
-        failure = std::current_exception();
-      }
-      const std::lock_guard lock(mutex);
-      done = true;
-      wake.notify_all();
-    });
-    for (bool finished = false; !finished;) {
-      std::vector<render::RenderProgress> batch;
-      {
-        std::unique_lock lock(mutex);
-        wake.wait_for(lock, std::chrono::milliseconds(50), [&] { return done || !reports.empty(); });
-        batch.swap(reports);
-        finished = done;
-      }
-      if (pending.set()) continue;  // cancelled: wait for the worker, call nothing more
-      const py::gil_scoped_acquire acquire;
-      for (const render::RenderProgress& report : batch) {
-        if (progress.is_none() || pending.set()) break;
-        py::dict d;
-        d["samples_done"] = report.samples_done;
-        d["samples_total"] = report.samples_total;
-        d["paths"] = report.paths;
-        d["elapsed_seconds"] = report.elapsed_seconds;
-        PyObject* r = PyObject_CallOneArg(progress.ptr(), d.ptr());
-        if (r == nullptr) {
-          pending.fetch();
-          cancel.store(true);
-        } else {
-          Py_DECREF(r);
-        }
-      }
-      if (pending.set()) continue;
-      if (PyErr_CheckSignals() != 0) {
-        pending.fetch();
-        interrupted_by_signal = true;
-        cancel.store(true);
-      }
-    }
-    worker.join();
-  }
-  if (failure && !pending.set()) std::rethrow_exception(failure);
-  if (pending.set()) {
-    // Ctrl-C: the exception carries the passes completed so far (a valid, shorter render).
-    interrupted_by_signal = interrupted_by_signal || PyErr_GivenExceptionMatches(pending.type, PyExc_KeyboardInterrupt);
-    if (interrupted_by_signal && !failure && image.width > 0) {
-      PyErr_NormalizeException(&pending.type, &pending.value, &pending.traceback);
-      image.info.render_options = render::overrides_to_json(given);
-      py::dict partial = image_to_py(std::move(image));
-      if (pending.value != nullptr) PyObject_SetAttrString(pending.value, "_prizma_image", partial.ptr());
-    }
-    pending.restore();
-    throw py::error_already_set();
-  }
-  if (record_scene_path) image.info.scene_path = std::filesystem::absolute(scene.source).lexically_normal().string();
-  image.info.render_options = render::overrides_to_json(given);
-  py::dict out = image_to_py(std::move(image));
-  py::dict s;
-  s["paths"] = stats.paths;
-  s["paths_in_volume"] = stats.paths_in_volume;
-  s["collisions"] = stats.collisions;
-  s["nan_or_inf_count"] = stats.nan_or_inf_count;
-  s["samples_completed"] = stats.samples_completed;
-  s["interrupted"] = stats.interrupted;
-  s["wall_seconds"] = stats.wall_seconds;
-  out["stats"] = s;
   return out;
 }
 
@@ -685,7 +564,8 @@ PYBIND11_MODULE(_prizma, m) {
         py::arg("bins"), py::arg("basis_size"), py::arg("min_split_delta_e"));
   m.def("design_light", &design_light, py::arg("albedo_a"), py::arg("albedo_b"), py::arg("goal"),
         py::arg("reference"), py::arg("primaries"), py::arg("cmf"), py::arg("bins"), py::arg("max_power_ratio"));
-  m.def("render", &render_scene, py::arg("scene_path"), py::arg("samples"), py::arg("threads"), py::arg("seed"),
-        py::arg("width"), py::arg("height"), py::arg("bins"), py::arg("variance"), py::arg("samples_per_pass"),
-        py::arg("progress"), py::arg("record_scene_path"));
+  m.def("render", &prizma::python::render_scene, py::arg("scene"), py::arg("scene_is_json"), py::arg("base_dir"), py::arg("samples"),
+        py::arg("threads"), py::arg("seed"), py::arg("width"), py::arg("height"), py::arg("bins"), py::arg("variance"),
+        py::arg("samples_per_pass"), py::arg("progress"));
+  prizma::python::register_exit_hook();
 }

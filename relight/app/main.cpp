@@ -120,10 +120,11 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
 
 // session.save(), with what libpng prints on stderr (e.g. "libpng error: No IDATs written into
 // file" when memory runs out) made part of the one error line, and running out of memory named.
-void save_one_line(relight::RelightSession& session, const std::string& output, bool quiet) {
+void save_one_line(relight::RelightSession& session, const std::string& output, bool quiet,
+                   spectral::OutputGroup* group) {
   spectral::StderrCapture capture;
   try {
-    spectral::allocating("writing " + output, [&] { session.save(output); });
+    spectral::allocating("writing " + output, [&] { session.save(output, "--output", group); });
   } catch (const InputError& e) {
     throw InputError(e.input(), e.reason() + spectral::library_said("libpng", capture.finish(), e.what()));
   } catch (const spectral::RuntimeError& e) {
@@ -218,15 +219,18 @@ int run(const CliOptions& o) {
       outputs.emplace_back(batch[i].file, o.batch + ": outputs[" + std::to_string(i) + "].file");
     spectral::check_distinct_outputs(outputs);
   }
+  // The batch's images and -o appear together or not at all (a full disk on the last leaves none).
+  spectral::OutputGroup outputs;
   if (!batch.empty()) {
-    relight::run_batch(session, batch, o.verbose ? &std::cerr : nullptr);
+    relight::run_batch(session, batch, o.verbose ? &std::cerr : nullptr, &outputs);
     session.apply(cli_settings);
   }
   if (!o.output.empty()) {
     const double ms = spectral::allocating("relighting", [&] { return session.relight(); });
-    save_one_line(session, o.output, o.quiet);
+    save_one_line(session, o.output, o.quiet, &outputs);
     if (o.verbose) std::cerr << "prizma-relight: wrote " << o.output << " (relit in " << ms << " ms)\n";
   }
+  outputs.commit();
   if (o.show && !o.interactive) {
     const relight::XyzImage& img = session.xyz();
     const std::vector<float> rgb = relight::to_display(img, session.display());
@@ -267,15 +271,11 @@ int run(const CliOptions& o) {
 // coefficients to a spectral EXR (docs/relight.md, "Compressed transport").
 int run_compress(const std::string& input, const std::string& output, const relight::CompressFileOptions& options,
                  bool quiet) {
-  spectral::require_regular_file(input, "an OpenEXR file");
+  spectral::require_regular_file(input, "an OpenEXR file");  // an input: the output may not replace it
   spectral::check_output_file(output, "--output");
   std::filesystem::path out_path(output);
   if (out_path.extension() != ".exr") {
     throw InputError("--output", output + ": the compressed file is a spectral EXR: give it the extension .exr");
-  }
-  std::error_code ec;
-  if (std::filesystem::equivalent(input, output, ec)) {
-    throw InputError("--output", output + " is the input file: write the compressed file beside it");
   }
   const relight::CompressedTransport t = spectral::allocating("compressing " + input, [&] {
     return relight::compress_spectral_exr(input, output, options);
@@ -305,8 +305,10 @@ int compress_main(int argc, char** argv) {
   relight::CompressFileOptions options;
   bool no_verify = false, quiet = false;
   int threads = 0;
-  app.add_option("input", input, "spectral EXR with transport bins")->required();
-  app.add_option("-o,--output", output, "the compressed spectral EXR (written atomically)")->required();
+  app.add_option("input", input, "spectral EXR with transport bins")->required()->check(spectral::non_empty_path());
+  app.add_option("-o,--output", output, "the compressed spectral EXR (written atomically)")
+      ->required()
+      ->check(spectral::non_empty_path());
   app.add_flag("--compact", options.compact,
                "drop the transport bins (and variance): the file is then relit only from the coefficients");
   app.add_option("--max-error", options.criterion.max_delta_e,
@@ -329,9 +331,11 @@ int main(int argc, char** argv) {
   CLI::App app{"Relights a Prizma spectral EXR under any light spectra (no re-render).", "prizma-relight"};
   CliOptions o;
   app.add_option("input", o.input, "spectral EXR written by prizma-render (or any reflective spectral EXR)")
-      ->required();
+      ->required()
+      ->check(spectral::non_empty_path());
   app.add_option("-o,--output", o.output,
-                 "output image: .png (8/16-bit), .tif, .jpg (8-bit), .exr (linear XYZ or --colour-space)");
+                 "output image: .png (8/16-bit), .tif, .jpg (8-bit), .exr (linear XYZ or --colour-space)")
+      ->check(spectral::non_empty_path());
   app.add_option("--light", o.lights,
                  "NAME=SPEC for one light layer, or SPEC for every layer; SPEC: D65, A, F11, LED-B1, "
                  "blackbody:3200K, gaussian:550:20, box:500:560, csv:FILE, off, …*SCALE (repeatable)")
@@ -343,12 +347,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--colour-space,--color-space", o.colour_space,
                  "linear OCIO colour space for EXR output (refused with only a PNG/TIFF/JPEG output)");
-  app.add_option("--ocio", o.ocio, "OpenColorIO config file (default: $OCIO, else Prizma's own)");
+  app.add_option("--ocio", o.ocio, "OpenColorIO config file (default: $OCIO, else Prizma's own)")
+      ->check(spectral::non_empty_path());
   app.add_flag("--absolute", o.absolute, "absolute light units (no normalisation to Y = 1 for white)");
   app.add_option("--bit-depth", o.bit_depth, "PNG/TIFF bit depth")->check(CLI::IsMember({8, 16}))->capture_default_str();
-  app.add_option("--batch", o.batch, "JSON file listing outputs and their settings (docs/relight.md)");
+  app.add_option("--batch", o.batch, "JSON file listing outputs and their settings (docs/relight.md)")
+      ->check(spectral::non_empty_path());
   app.add_flag("-i,--interactive", o.interactive, "read commands from stdin (type 'help')");
-  app.add_option("--preview", o.preview, "interactive: image rewritten after every change");
+  app.add_option("--preview", o.preview, "interactive: image rewritten after every change")
+      ->check(spectral::non_empty_path());
   app.add_flag("--show", o.show, "print a true-colour terminal thumbnail (with -i: draw the image at the start)");
   app.add_flag("--show-every", o.show_every, "interactive: draw the image after every change");
   app.add_flag("-v,--verbose", o.verbose, "echo data files, OCIO config and lights");
@@ -361,7 +368,9 @@ int main(int argc, char** argv) {
   app.add_flag("--serve", o.serve, "serve the live relighting page (prints its URL; Ctrl-C stops it)");
   app.add_option("--bind", o.bind, "--serve: address to listen on")->capture_default_str();
   app.add_option("--port", o.port, "--serve: port (0: a free one)")->check(CLI::Range(0, 65535))->capture_default_str();
-  app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")->capture_default_str();
+  app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")
+      ->capture_default_str()
+      ->check(spectral::non_empty_path());
   app.set_version_flag("--version", prizma::spectral::prizma_version());
   app.footer("Also: prizma-relight compress IN.exr -o OUT.exr [--compact] [--max-error DE] adds spectral-basis "
              "coefficients (prizma-relight compress --help).");

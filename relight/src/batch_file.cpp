@@ -143,11 +143,13 @@ std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSess
   return outputs;
 }
 
-void run_batch(RelightSession& session, const std::vector<BatchOutput>& outputs, std::ostream* log) {
-  for (const BatchOutput& out : outputs) {
+void run_batch(RelightSession& session, const std::vector<BatchOutput>& outputs, std::ostream* log,
+               spectral::OutputGroup* group) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const BatchOutput& out = outputs[i];
     session.apply(out.settings);
     const double ms = session.relight();
-    session.save(out.file);
+    session.save(out.file, "outputs[" + std::to_string(i) + "].file", group);
     if (log) *log << "wrote " << out.file.string() << " (relit in " << ms << " ms)\n";
   }
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "prizma/spectral/atomic_file.h"
+#include "prizma/spectral/output_group.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/image_io.h"
 
@@ -177,9 +178,9 @@ std::optional<spectral::PictureColourSpace> display_colour_space(const spectral:
 }
 
 void write_output_image(const fs::path& path, const XyzImage& image, const OutputOptions& opts,
-                        const ImageMetadata& metadata) {
-  const OutputFormat format = output_format_for(path);
-  check_output_path(path);
+                        const ImageMetadata& metadata, const std::string& input, spectral::OutputGroup* group) {
+  const OutputFormat format = output_format_for(path, input);
+  check_output_path(path, input);
   check_output_options(format, opts);
 
   // Pixels: linear XYZ / colour space for EXR, display-encoded and clamped to [0, 1] otherwise.
@@ -225,7 +226,7 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
 
   spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {
     spectral::write_picture(out, spec, spectral::PicturePixelType::Float, pixels.data());
-  });
+  }, group);
 }
 
 }  // namespace prizma::relight

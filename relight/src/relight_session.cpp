@@ -260,8 +260,8 @@ CompareResult RelightSession::compare(int x1, int y1, int x2, int y2, int radius
   return r;
 }
 
-void RelightSession::save(const std::filesystem::path& path) {
-  write_output_image(path, xyz(), m_settings.output, metadata());
+void RelightSession::save(const std::filesystem::path& path, const std::string& input, spectral::OutputGroup* group) {
+  write_output_image(path, xyz(), m_settings.output, metadata(), input, group);
 }
 
 ImageMetadata RelightSession::metadata() const {

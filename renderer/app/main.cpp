@@ -21,6 +21,8 @@
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
+#include "prizma/spectral/output_group.h"
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/tool_main.h"
 
@@ -84,8 +86,8 @@ struct Options {
 };
 
 // Refuses before any work outputs that cannot be written (spectral::check_output_file: a folder, a
-// device, a FIFO, a missing or read-only folder, …), a preview in a format that cannot be written,
-// and a preview that is the same file as the output.
+// device, a FIFO, a missing or read-only folder, a file the run reads, …), a preview in a format that
+// cannot be written, and a preview that is the same file as the output.
 void check_outputs(const std::filesystem::path& output, const std::string& output_input, const std::string& preview) {
   std::vector<std::pair<std::filesystem::path, std::string>> outputs{{output, output_input}};
   if (!preview.empty()) {
@@ -131,18 +133,23 @@ class ProgressBar {
   bool m_drawn = false;
 };
 
+// The EXR and the preview appear together or not at all (a full disk on the preview leaves neither).
 void write_outputs(const spectral::SpectralImage& image, const std::filesystem::path& output, bool half,
                    const std::string& preview, const std::vector<render::Light>& lights,
                    const std::filesystem::path& spectrum_base_dir, int threads) {
+  spectral::OutputGroup outputs;
   spectral::ExrWriteOptions wo;
   wo.pixel_type = half ? spectral::ExrPixelType::Half : spectral::ExrPixelType::Float;
   wo.threads = threads;  // --threads holds for OpenEXR's encoding too
+  wo.group = &outputs;
   spectral::write_spectral_exr(output, image, wo);
   if (!preview.empty()) {
     render::PreviewOptions po;
     po.spectrum_base_dir = spectrum_base_dir;
+    po.group = &outputs;
     render::write_preview(preview, image, lights, po);
   }
+  outputs.commit();
 }
 
 int merge_main(int argc, char** argv) {
@@ -153,9 +160,12 @@ int merge_main(int argc, char** argv) {
   std::string output, preview;
   bool half = false, quiet = false, verbose = false, strict = false, no_verify = false;
   int threads = 0;
-  app.add_option("shards", inputs, "shard files (spectral EXR written by prizma-render)")->required();
-  app.add_option("-o,--output", output, "merged output file")->required();
-  app.add_option("--preview", preview, "also write an sRGB preview (PNG) under the lights' default spectra");
+  app.add_option("shards", inputs, "shard files (spectral EXR written by prizma-render)")
+      ->required()
+      ->check(spectral::non_empty_path());
+  app.add_option("-o,--output", output, "merged output file")->required()->check(spectral::non_empty_path());
+  app.add_option("--preview", preview, "also write an sRGB preview (PNG) under the lights' default spectra")
+      ->check(spectral::non_empty_path());
   app.add_flag("--half", half, "write half floats");
   app.add_flag("--strict", strict, "refuse shards that leave a gap in the sample range (exit 2)");
   app.add_flag("--no-verify", no_verify,
@@ -167,6 +177,10 @@ int merge_main(int argc, char** argv) {
   std::optional<tbb::global_control> thread_limit;
   if (threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
   return spectral::run_tool(kProgram, [&] {
+    check_outputs(output, "-o", preview);
+    // Then again with the shards recorded as inputs (require_regular_file): -o or --preview naming
+    // one is refused before any shard is read.
+    for (const auto& f : inputs) spectral::require_regular_file(f, "an OpenEXR file");
     check_outputs(output, "-o", preview);
     std::vector<spectral::SpectralImage> shards;
     spectral::ExrReadOptions read_options;
@@ -208,8 +222,10 @@ int main(int argc, char** argv) {
                kProgram};
   app.set_version_flag("--version", spectral::prizma_version());
   Options o;
-  app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own");
-  app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")");
+  app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own")
+      ->check(spectral::non_empty_path());
+  app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")")
+      ->check(spectral::non_empty_path());
   app.add_option("--spp", o.spp_text, "samples per pixel (renders samples [begin, begin + N); with --resume the total)");
   app.add_option("--width", o.width_text, "image width in pixels");
   app.add_option("--height", o.height_text, "image height in pixels");
@@ -229,10 +245,12 @@ int main(int argc, char** argv) {
   app.add_flag("--no-majorant-grid", o.no_majorant_grid, "one global majorant instead of the macrocell grid");
   app.add_flag("--variance", o.variance, "also write variance-of-the-mean layers");
   app.add_flag("--half", o.half, "write half floats (refused where values exceed half's range)");
-  app.add_option("--preview", o.preview, "also write an sRGB preview (PNG) under the lights' default spectra");
+  app.add_option("--preview", o.preview, "also write an sRGB preview (PNG) under the lights' default spectra")
+      ->check(spectral::non_empty_path());
   app.add_option("--resume", o.resume,
                  "continue a partial (interrupted) render from the scene and options it records, up to "
-                 "its target or --spp N in all, and merge (output defaults to this file)");
+                 "its target or --spp N in all, and merge (output defaults to this file)")
+      ->check(spectral::non_empty_path());
   app.add_flag("--no-verify", o.no_verify,
                "with --resume: read the file even when its pixels do not match prizma:checksum (re-encoded by "
                "another tool: docs/spectral-exr.md)");
@@ -244,7 +262,8 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", o.quiet, "no progress bar or summary");
   app.add_flag("-v,--verbose", o.verbose, "print the scene, mode and statistics");
   std::string ocio;  // accepted only to be refused with the reason (the tools share their vocabulary)
-  app.add_option("--ocio", ocio, "refused: a render converts nothing through OpenColorIO (give --ocio to prizma-relight)");
+  app.add_option("--ocio", ocio, "refused: a render converts nothing through OpenColorIO (give --ocio to prizma-relight)")
+      ->check(spectral::non_empty_path());
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   return spectral::run_tool(kProgram, [&] {
@@ -285,6 +304,8 @@ int main(int argc, char** argv) {
         throw InputError("-D", "not with --resume (the partial file's scene is continued as it was rendered)");
       render::ResumeRequest req{o.resume, o.scene, given, o.spp, !o.no_verify};
       render::ResumePlan plan = render::plan_resume(req);
+      // In place: the output (by default the file itself) replaces it only once complete.
+      spectral::allow_in_place_update(o.resume, {"-o", "--resume"});
       std::error_code ec;
       if (plan.complete && (o.output.empty() || std::filesystem::equivalent(o.output, o.resume, ec))) {
         if (!o.quiet)

@@ -2,13 +2,13 @@
 #include <cmath>
 
 #include "prizma/render/render.h"
-#include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/bispectral.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/light_spectrum.h"
 #include "prizma/spectral/image_io.h"
+#include "prizma/spectral/output_group.h"
 
 namespace prizma::render {
 
@@ -54,7 +54,7 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
   spec.colour_space = spectral::srgb_picture_colour_space();  // an sRGB ICC profile
   spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {
     spectral::write_picture(out, spec, spectral::PicturePixelType::UInt8, rgb8.data());
-  });
+  }, opts.group);
 }
 
 void check_preview_path(const std::filesystem::path& path, const std::string& input) {

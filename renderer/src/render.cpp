@@ -400,7 +400,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   img.info.light_records = light_records(scene.lights);
   img.info.samples = done;
   img.info.sample_range = SampleRange{st.sample_begin, st.sample_begin + done}.to_string();
-  img.info.seed = static_cast<std::int64_t>(st.seed);
+  img.info.seed = st.seed;
   img.info.scene_hash = scene.hash;
   img.info.version = spectral::prizma_version();
   img.info.wavelength_sampling = wavelength_sampling_name(st.wavelength_sampling);

@@ -540,7 +540,9 @@ std::string absolute_spec(const std::string& spec, const std::filesystem::path& 
   return "csv:" + (base / p).string() + (star == std::string::npos ? "" : spec.substr(star));
 }
 
-// The emission layer's name: as a light's, 1–64 letters, digits, '_' and '-'.
+// A light layer's name (a light's, the emission layer's): 1–64 letters, digits, '_' and '-', and not
+// a name the spectral EXR reserves ("var" names the variance layers): refused here, before rendering,
+// not by the writer after it.
 void check_light_name(const Reader& rd, const std::string& name, const std::string& path) {
   if (name.empty() || name.size() > kMaxLightNameLength) {
     rd.fail(path, "must have 1 to " + std::to_string(kMaxLightNameLength) + " characters (got \"" + name + "\")");
@@ -550,6 +552,7 @@ void check_light_name(const Reader& rd, const std::string& name, const std::stri
       rd.fail(path, "may hold only letters, digits, '_' and '-' (got \"" + name + "\")");
     }
   }
+  spectral::check_exr_light_name(name, rd.input(path));
 }
 
 // A point, sphere or spot light ("position") or an environment map ("environment"), with their
@@ -630,15 +633,7 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
     const std::string np = Reader::join(lp, "name");
     if (!lj.contains("name")) rd.fail(np, "is required");
     l.name = rd.string(lj.at("name"), np);
-    if (l.name.empty() || l.name.size() > kMaxLightNameLength) {
-      rd.fail(np, "must have 1 to " + std::to_string(kMaxLightNameLength) + " characters (got \"" + l.name + "\")");
-    }
-    for (char ch : l.name) {
-      if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-')) {
-        rd.fail(np, "may hold only letters, digits, '_' and '-' (got \"" + l.name + "\")");
-      }
-    }
-    spectral::check_exr_light_name(l.name, rd.input(np));  // "var" names the variance layers
+    check_light_name(rd, l.name, np);
     if (!names.insert(l.name).second) rd.fail(np, "duplicate light name \"" + l.name + "\"");
     const std::string dp = Reader::join(lp, "direction");
     if (lj.contains("position") || lj.contains("environment")) {
@@ -941,15 +936,12 @@ std::uint64_t scene_seed_override(const std::string& text, const std::string& op
   return read_seed(Reader("", {}), j, option);
 }
 
-Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverride>& overrides) {
-  const std::string file = path.string();
-  spectral::require_regular_file(path, "a scene file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(file, "cannot open scene file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+namespace {
 
+// The scene in `text`, named `file` in messages; `path` is its source (relative paths resolve in its
+// folder; the default output is beside it).
+Scene scene_from_text(const std::string& text, const std::string& file, const std::filesystem::path& path,
+                      const std::vector<SceneOverride>& overrides) {
   json root = parse_json(text, file);
   std::vector<std::string> overridden;
   if (!overrides.empty() && !root.is_object()) throw InputError(file, "must be an object (the scene) for -D");
@@ -1049,6 +1041,23 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverr
     if (l.environment_map) h.add(l.environment_map->values().data(), l.environment_map->values().size() * sizeof(float));
   scene.hash = h.hex();
   return scene;
+}
+
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverride>& overrides) {
+  const std::string file = path.string();
+  spectral::require_regular_file(path, "a scene file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(file, "cannot open scene file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return scene_from_text(buffer.str(), file, path, overrides);
+}
+
+Scene load_scene_text(const std::string& text, const std::string& input, const std::filesystem::path& base_dir,
+                      const std::vector<SceneOverride>& overrides) {
+  return scene_from_text(text, input, base_dir / input, overrides);
 }
 
 }  // namespace prizma::render

@@ -29,3 +29,11 @@ foreach(case ${_outputs_cases})
   set_tests_properties(outputs.e2e.${case} PROPERTIES FIXTURES_REQUIRED outputs_files LABELS outputs TIMEOUT 300
                        ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
 endforeach()
+# The run's outputs as a whole (tests/e2e/outputs/check-run-outputs): outputs that are inputs, empty
+# paths, a full disk part way (a real tmpfs: needs mount; skipped, exit 77, where it cannot mount).
+list(TRANSFORM _outputs_cmd REPLACE "/check-outputs$" "/check-run-outputs" OUTPUT_VARIABLE _run_outputs_cmd)
+foreach(case inputs empty_paths disk_full)
+  add_test(NAME outputs.e2e.${case} COMMAND ${_run_outputs_cmd} ${case})
+  set_tests_properties(outputs.e2e.${case} PROPERTIES FIXTURES_REQUIRED outputs_files LABELS outputs TIMEOUT 300
+                       SKIP_RETURN_CODE 77 ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+endforeach()

@@ -34,5 +34,5 @@ prizma_compressed_e2e(compress_missing "compress|nowhere.exr|-o|err_missing.exr"
   ERR_REGEX "nowhere\\.exr" MUST_NOT_EXIST err_missing.exr)
 prizma_compressed_e2e(compress_no_folder "compress|scene.exr|-o|no_such_folder/x.exr" EXPECT_RC 2 ERR_REGEX "no_such_folder")
 prizma_compressed_e2e(compress_not_exr "compress|scene.exr|-o|err_png.png" EXPECT_RC 2 ERR_REGEX "\\.exr" MUST_NOT_EXIST err_png.png)
-prizma_compressed_e2e(compress_onto_input "compress|scene.exr|-o|./scene.exr" EXPECT_RC 2 ERR_REGEX "is the input file")
+prizma_compressed_e2e(compress_onto_input "compress|scene.exr|-o|./scene.exr" EXPECT_RC 2 ERR_REGEX "would replace \"scene.exr\", the OpenEXR file this run reads")
 prizma_compressed_e2e(compress_help "compress|--help" OUT_REGEX "--compact|--max-error")

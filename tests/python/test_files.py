@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import prizma
-from conftest import cli_error
+from conftest import cli_error, run_tool
 
 
 def test_read_gives_the_layout(tiny_exr):
@@ -139,3 +139,66 @@ def test_write_refuses_lights_its_reader_would_refuse(tmp_path, lights, message)
     with pytest.raises(prizma.InputError, match=message):
         prizma.write(out, image)
     assert not out.exists()
+
+
+def test_paths_with_a_nul_are_refused_as_open_refuses_them(tiny_exr, tiny_scene, tmp_path):
+    """A NUL would cut the path short in C++ ("a.exr\\0.txt" read or written as a.exr): ValueError."""
+    image = prizma.read(tiny_exr)
+    existing = tmp_path / "a.exr"
+    prizma.write(existing, image)
+    before = existing.read_bytes()
+    calls = [
+        ("path", lambda: prizma.read(str(existing) + "\0.txt")),
+        ("path", lambda: prizma.write(str(existing) + "\0.txt", image)),
+        ("image", lambda: prizma.relight(os.fsencode(existing) + b"\0x")),
+        ("config", lambda: prizma.relight(image, config=str(tmp_path) + "\0cfg.ocio")),
+        ("scene", lambda: prizma.render(tiny_scene + "\0.json", samples=1)),
+        ("base_dir", lambda: prizma.render({}, base_dir=str(tmp_path) + "\0")),
+    ]
+    for name, call in calls:
+        with pytest.raises(ValueError) as e:
+            call()
+        assert isinstance(e.value, prizma.InputError)
+        assert str(e.value) == f"{name}: embedded null byte"
+    assert existing.read_bytes() == before
+
+
+def test_write_stores_only_lights_its_own_reader_takes(tiny_exr, tmp_path):
+    image = prizma.read(tiny_exr)
+    out = tmp_path / "lights.exr"
+    image.attributes["lights"][0]["angularSizeDeg"] = float("nan")  # json.dumps would write NaN: not JSON
+    with pytest.raises(prizma.InputError, match=r'^attributes\["lights"\]: cannot be stored as JSON'):
+        prizma.write(out, image)
+    image.attributes["lights"] = "not JSON"
+    with pytest.raises(prizma.InputError, match=r'^attributes\["lights"\]: is not valid JSON$'):
+        prizma.write(out, image)
+    image.attributes["lights"] = _nested(200)
+    with pytest.raises(prizma.InputError, match=r'^attributes\["lights"\]: JSON nested deeper than 128 levels'):
+        prizma.write(out, image)
+    assert not out.exists()
+    # What it writes reads back as written.
+    lights = [{"name": "side", "spectrum": "A", "direction": [0.5, 0.0, 1.0]}, {"name": "sky", "spectrum": "F11"}]
+    image.attributes["lights"] = lights
+    prizma.write(out, image)
+    assert prizma.read(out).attributes["lights"] == lights
+
+
+def _nested(depth):
+    value = []
+    for _ in range(depth - 1):
+        value = [value]
+    return value
+
+
+def test_the_largest_seed_is_recorded_exactly(tiny_scene, tmp_path):
+    """prizma:seed holds every 64-bit seed (2^64 − 1 was recorded as −1)."""
+    out = tmp_path / "seed.exr"
+    run_tool("render", tiny_scene, "-o", out, "-q", "--spp", "1", "--seed", str(2**64 - 1))
+    image = prizma.read(out)
+    assert image.attributes["seed"] == 2**64 - 1
+    again = tmp_path / "again.exr"
+    prizma.write(again, image)
+    assert prizma.read(again).attributes["seed"] == 2**64 - 1
+    image.attributes["seed"] = -1
+    with pytest.raises(prizma.InputError, match=r'^attributes\["seed"\]: must be an integer ≥ 0'):
+        prizma.write(again, image)

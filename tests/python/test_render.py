@@ -2,6 +2,8 @@
 import json
 import os
 import signal
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -94,3 +96,64 @@ def test_scene_errors_are_the_tools(tiny_scene, tmp_path):
     assert e.value.input.startswith("scene")
     with pytest.raises(prizma.InputError, match=r"^samples: "):
         prizma.render(tiny_scene, samples=0)
+
+
+def test_a_dict_is_rendered_without_writing_a_file(tiny_scene, tmp_path, monkeypatch):
+    """The scene of a dict is read from memory: nothing appears in the folder while it renders (a
+    temporary there failed in a read-only folder and stayed behind after SIGTERM)."""
+    monkeypatch.chdir(tmp_path)
+    seen = []
+    prizma.render(tiny_dict(tiny_scene), samples=2, samples_per_pass=1,
+                  progress=lambda report: seen.append(os.listdir(tmp_path)))
+    assert seen == [[], []]
+
+
+@pytest.mark.parametrize("argument, value, option", [
+    ("seed", -1, "--seed"), ("seed", 2**64, "--seed"), ("width", 0, "--width"), ("width", 2**70, "--width"),
+    ("height", -3, "--height"), ("samples", 2**63, "--spp")])
+def test_integer_arguments_fail_in_one_line_as_the_tools_options(tiny_scene, tmp_path, argument, value, option):
+    message, status = cli_error("render", tiny_scene, "-o", tmp_path / "x.exr", option, str(value))
+    assert status == 2 and message.startswith(option + ": ")
+    with pytest.raises(prizma.InputError) as e:
+        prizma.render(tiny_scene, **{argument: value})
+    assert str(e.value) == argument + message[len(option):]
+    assert e.value.input == argument
+
+
+@pytest.mark.parametrize("arguments, message", [
+    ({"threads": -1}, "threads: must be in [0, 65536] (0: all cores) (got -1)"),
+    ({"samples_per_pass": 2**64}, "samples_per_pass: must be in [0, 1099511627776] (0: automatic) (got 18446744073709551616)"),
+    ({"seed": "3"}, "seed: must be an integer (got '3')"),
+    ({"samples": 2.5}, "samples: must be an integer (got 2.5)"),
+    ({"width": True}, "width: must be an integer (got True)")])
+def test_other_integer_arguments_fail_in_one_line(tiny_scene, arguments, message):
+    with pytest.raises(prizma.InputError) as e:
+        prizma.render(tiny_scene, **arguments)
+    assert str(e.value) == message
+
+
+EXIT_WHILE_CALLING = r'''
+import sys, threading, prizma
+kind, path = sys.argv[1], sys.argv[2]
+started = threading.Event()
+def work():
+    if kind == "render":
+        prizma.render(path, samples=10**9, samples_per_pass=1, progress=lambda report: started.set())
+    image = prizma.read(path)
+    while True:
+        prizma.relight(image, "A")
+        started.set()
+threading.Thread(target=work, daemon=True).start()
+started.wait(60)
+print("exiting", flush=True)
+'''
+
+
+@pytest.mark.parametrize("kind", ["render", "relight"])
+def test_the_interpreter_exits_cleanly_while_a_thread_calls_in(tiny_scene, tiny_exr, kind):
+    """The interpreter exits while a daemon thread renders or relights: exit 0, nothing on stderr
+    (it aborted with "terminate called without an active exception", exit 134)."""
+    path = tiny_scene if kind == "render" else str(tiny_exr)
+    proc = subprocess.run([sys.executable, "-c", EXIT_WHILE_CALLING, kind, path], capture_output=True, text=True,
+                          timeout=120)
+    assert (proc.returncode, proc.stdout, proc.stderr) == (0, "exiting\n", "")

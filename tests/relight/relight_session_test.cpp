@@ -4,6 +4,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <sstream>
 
@@ -13,6 +14,7 @@
 #include "prizma/relight/relight_session.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/input_file.h"
 #include "relight/relight_test_util.h"
 
 namespace prizma::relight {
@@ -149,6 +151,28 @@ TEST(RelightSession, ExrOutputHoldsTheXyzAndMetadata) {
   EXPECT_EQ(spec.get_string_attribute("prizma:exposureEV"), "1");
   EXPECT_NE(spec.get_string_attribute("prizma:lights").find("A*0.5"), std::string::npos);
   EXPECT_EQ(spec.get_string_attribute("prizma:cmf"), "cie1931-2");
+}
+
+// What the shell's save and the live page's Save call: an output that is the file being relit is
+// refused naming the caller's input ("save", "file"), the file left as it was (docs/errors.md).
+TEST(RelightSession, SaveNeverReplacesTheFileItRelights) {
+  const fs::path dir = test::scratch_dir("save_input");
+  const spectral::InputRecording recording;  // as run_tool holds it in the tools
+  const fs::path in = write_fixture(dir);
+  RelightSession session(in);
+  std::ifstream before_stream(in, std::ios::binary);
+  const std::string before((std::istreambuf_iterator<char>(before_stream)), std::istreambuf_iterator<char>());
+  try {
+    session.save(dir / "." / "scene.exr", "file");
+    FAIL() << "saved over the input";
+  } catch (const spectral::InputError& e) {
+    EXPECT_EQ(e.input(), "file");
+    EXPECT_NE(e.reason().find("the OpenEXR file this run reads"), std::string::npos) << e.what();
+  }
+  std::ifstream after_stream(in, std::ios::binary);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(after_stream)), std::istreambuf_iterator<char>()), before);
+  session.save(dir / "saved.exr", "file");
+  EXPECT_TRUE(fs::is_regular_file(dir / "saved.exr"));
 }
 
 TEST(InteractiveShell, ScriptedSessionThroughAStream) {

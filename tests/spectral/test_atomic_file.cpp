@@ -20,6 +20,7 @@
 
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
+#include "spectral/scratch_files.h"
 
 namespace fs = std::filesystem;
 using prizma::spectral::AtomicOutput;
@@ -31,26 +32,10 @@ using prizma::spectral::write_atomically;
 
 namespace {
 
-fs::path scratch_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("prizma-test-atomic-" + std::to_string(::getpid()) + "-" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using prizma::spectral::test::read_all;
+using prizma::spectral::test::write_text;
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_text(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-  if (!out) throw std::runtime_error("cannot write " + p.string());
-}
+fs::path scratch_dir(const std::string& name) { return prizma::spectral::test::scratch_dir("atomic", name); }
 
 void write_text(AtomicOutput& out, const std::string& text) {
   if (!out.write(text)) throw std::runtime_error("cannot write " + out.temporary().string());

@@ -221,7 +221,7 @@ TEST_F(SpectralExr, OneLightRoundTripIsBitExact) {
 TEST_F(SpectralExr, ThreeLightsWithVarianceRoundTrip) {
   SpectralImage img = make_image(6, 4, BinLayout::linear(380, 780, 16), {"key", "fill", "rim_2"}, true);
   img.lights[1].variance.clear();  // one light without variance
-  img.info.seed = std::int64_t{1} << 40;  // beyond int32: stored as a string attribute
+  img.info.seed = std::uint64_t{1} << 40;  // beyond int32: stored as a string attribute
   const fs::path p = file("three.exr");
   write_spectral_exr(p, img);
 
@@ -244,7 +244,7 @@ TEST_F(SpectralExr, ThreeLightsWithVarianceRoundTrip) {
   }
   EXPECT_EQ(back.find_light("rim_2"), 2);
   EXPECT_EQ(back.find_light("nope"), -1);
-  EXPECT_EQ(back.info.seed, std::int64_t{1} << 40);
+  EXPECT_EQ(back.info.seed, std::uint64_t{1} << 40);
 
   // The top-level layer is the sum of the lights (what a reader of the published layout shows).
   Imf::InputFile f(p.c_str());
@@ -566,6 +566,37 @@ TEST_F(SpectralExr, DamagedPixelDataIsNeverReadSilently) {
   EXPECT_GT(refused_by_checksum, 0);
   std::cout << "damaged bytes: " << refused_by_checksum << " refused by the checksum, " << refused_otherwise
             << " by OpenEXR, " << unchanged << " unchanged\n";
+}
+
+// prizma:seed holds every 64-bit seed: 2^64 − 1 is a string attribute "18446744073709551615" (it was
+// the int −1 before), and the files that stored seeds from 2^63 on as negative numbers read back the
+// seed they were rendered with (docs/spectral-exr.md).
+TEST_F(SpectralExr, SeedKeepsAllSixtyFourBits) {
+  SpectralImage img = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"});
+  img.info.seed = std::numeric_limits<std::uint64_t>::max();
+  const fs::path p = file("seed.exr");
+  write_spectral_exr(p, img);
+  EXPECT_EQ(read_spectral_exr(p).info.seed, std::numeric_limits<std::uint64_t>::max());
+  {
+    Imf::InputFile f(p.c_str());
+    const auto* attr = f.header().findTypedAttribute<Imf::StringAttribute>("prizma:seed");
+    ASSERT_NE(attr, nullptr);
+    EXPECT_EQ(attr->value(), "18446744073709551615");
+  }
+  const fs::path old_int = rewrite_header(p, file("seed-old-int.exr"), [](Imf::Header& h) {
+    h.erase("prizma:seed");
+    h.insert("prizma:seed", Imf::IntAttribute(-1));
+  });
+  EXPECT_EQ(read_spectral_exr(old_int).info.seed, std::numeric_limits<std::uint64_t>::max());
+  const fs::path old_string = rewrite_header(p, file("seed-old-string.exr"), [](Imf::Header& h) {
+    h.insert("prizma:seed", Imf::StringAttribute("-9223372036854775807"));  // 2^63 + 1
+  });
+  EXPECT_EQ(read_spectral_exr(old_string).info.seed, (std::uint64_t{1} << 63) + 1);
+  const fs::path bad = rewrite_header(p, file("seed-bad.exr"), [](Imf::Header& h) {
+    h.insert("prizma:seed", Imf::StringAttribute("18446744073709551616"));  // 2^64
+  });
+  EXPECT_NE(read_error(bad).find("prizma:seed: \"18446744073709551616\" is not a 64-bit seed"), std::string::npos)
+      << read_error(bad);
 }
 
 TEST_F(SpectralExr, RefusesUnknownChecksumKind) {

@@ -447,7 +447,7 @@ void RelightServer::Impl::routes() {
     const std::string name = req.get_param_value("file");
     const std::lock_guard lock(mutex);
     apply_state(req, {"file"});
-    const fs::path path = save_folder.save(name, [this](const fs::path& p) { session.save(p); });
+    const fs::path path = save_folder.save(name, [this](const fs::path& p) { session.save(p, "file"); });
     send_json(res, {{"file", name}, {"path", path.string()}, {"state", state_string(session.settings(), session)}});
   }));
   pool = std::make_unique<ConnectionPool>(limits, [this](Connection& c) {

@@ -159,7 +159,7 @@ class Shell {
     std::string line = "relit in " + ms_text(ms);
     if (!m_opts.preview.empty()) {
       const auto start = std::chrono::steady_clock::now();
-      m_session.save(m_opts.preview);
+      m_session.save(m_opts.preview, "--preview");
       line += ", preview written in " + ms_text(ms_since(start));
     }
     m_out << line << "\n";
@@ -293,7 +293,7 @@ void run_command(RelightSession& session, Shell& shell, std::ostream& out, const
   } else if (cmd == "save") {
     expect_args(w, 1, 1, "save FILE");
     const auto start = std::chrono::steady_clock::now();
-    session.save(w[1]);
+    session.save(w[1], "save");
     out << "saved " << w[1] << " in " << ms_text(ms_since(start)) << "\n";
   } else if (cmd == "probe") {
     expect_args(w, 2, 3, "probe X Y [LIGHT]");

@@ -5,6 +5,8 @@
 //   fsync    fsync() of Prizma's temporaries (files named .prizma-tmp-*) fails
 //   close    close() of a temporary closes it and then reports EIO (as NFS does for a lost write)
 //   dirsync  fsync() of a folder fails (the rename is done, its durability is not)
+//   rename2  the second rename() of a temporary into place fails (an OutputGroup's commit: the first
+//            output, already renamed, must be put back)
 // Everything else goes through to the C library unchanged.
 #include <dlfcn.h>
 #include <sys/stat.h>
@@ -33,6 +35,11 @@ int is_temporary(int fd) {
   return base != nullptr && std::strncmp(base + 1, ".prizma-tmp-", 12) == 0;
 }
 
+int is_temporary_name(const char* path) {
+  const char* base = std::strrchr(path, '/');
+  return std::strncmp(base != nullptr ? base + 1 : path, ".prizma-tmp-", 12) == 0;
+}
+
 int is_directory(int fd) {
   struct stat st {};
   return fstat(fd, &st) == 0 && S_ISDIR(st.st_mode);
@@ -57,6 +64,23 @@ extern "C" int fsync(int fd) {
     return -1;
   }
   return real(fd);
+}
+
+extern "C" int rename(const char* from, const char* to) {
+  using rename_call = int (*)(const char*, const char*);
+  static rename_call real = [] {
+    void* f = dlsym(RTLD_NEXT, "rename");
+    if (f == nullptr) std::abort();
+    rename_call call = nullptr;
+    std::memcpy(&call, &f, sizeof call);
+    return call;
+  }();
+  static int temporaries_renamed = 0;
+  if (fault_is("rename2") && is_temporary_name(from) && ++temporaries_renamed == 2) {
+    errno = EIO;
+    return -1;
+  }
+  return real(from, to);
 }
 
 extern "C" int close(int fd) {

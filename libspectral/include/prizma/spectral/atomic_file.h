@@ -2,10 +2,12 @@
 // Every output file of every tool goes through here (docs/errors.md, "Outputs").
 //   check_output_file / check_distinct_outputs: before any work, refuse an output path that cannot be
 //     written as a regular file (a folder, a device, a FIFO, a socket, a dangling symbolic link, a
-//     missing or read-only folder, a name too long) and two outputs of one run naming the same file.
+//     missing or read-only folder, a name too long), one that is a file the run reads (an input
+//     recorded by InputRecording, input_file.h) and two outputs of one run naming the same file.
 //   write_atomically: the bytes go to a temporary in the destination's folder through AtomicOutput,
 //     which checks every write; the temporary is fsync'ed, its size checked and only then renamed
 //     over the destination. A failed write never leaves a partial file and never touches an existing one.
+//   The outputs of one run go through an OutputGroup (output_group.h): all appear, or none.
 #include <sys/types.h>
 
 #include <cstddef>
@@ -32,8 +34,9 @@ struct OutputTarget {
 // a new file in an existing writable folder, or an existing regular file (through symbolic links,
 // whose final target is replaced and the links kept). Throws InputError(input, …) naming the path
 // when it is a folder, a character or block device, a FIFO, a socket, a symbolic link to a missing
-// file or a loop, in a missing or read-only folder, or when its name is longer than the file system
-// allows.
+// file or a loop, in a missing or read-only folder, when its name is longer than the file system
+// allows, or when it is a file the run reads ("-o: \"s.json\" would replace \"s.json\", the scene file
+// this run reads …"; allow_in_place_update names the options that may).
 OutputTarget check_output_file(const std::filesystem::path& path, const std::string& input);
 
 // Checks every output of one run with check_output_file and throws InputError (naming the second of
@@ -88,9 +91,10 @@ class AtomicOutput {
 // for the file system), calls write(out), then checks that no write failed, fsyncs the temporary,
 // checks its size, closes it and renames it over the destination, then fsyncs the folder. If write
 // throws or anything fails, the temporary is removed and an existing destination is untouched.
-// Throws InputError for a destination that is not a regular file (as check_output_file),
-// RuntimeError naming the path and the system's reason for every failure of the write, and lets a
-// writer's own exception through when no write failed.
+// Throws InputError for a destination that is not a regular file (as check_output_file; also for a
+// recorded input that no output may update in place), RuntimeError naming the path and the
+// system's reason for every failure of the write, and lets a writer's own exception through when
+// no write failed.
 void write_atomically(const std::filesystem::path& path, const std::function<void(AtomicOutput& out)>& write);
 
 // write_atomically of a whole file held in memory (CSV tables, JSON).

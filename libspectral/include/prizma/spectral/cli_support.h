@@ -8,6 +8,14 @@
 
 namespace prizma::spectral {
 
+// The check of every option that names a file or a folder: an empty value (a script's unset
+// variable, -o "$OUT") is refused as a usage error naming the option, never taken as "not given".
+inline CLI::Validator non_empty_path() {
+  return CLI::Validator(
+      [](std::string& value) { return value.empty() ? std::string("empty path ('' names no file)") : std::string(); },
+      "");
+}
+
 // Parses argv; on --help / --version prints to stdout and returns kExitOk; on a usage error prints
 // "prog: error: <message>" and "Try 'prog --help'." to stderr and returns kExitUsage. Returns -1 when
 // parsing succeeded and the program should go on.

@@ -12,13 +12,15 @@
 
 namespace prizma::spectral {
 
+class OutputGroup;
+
 struct SpectralExrInfo {
   // prizma:lights, one record per light (light_record.h). Written as given; when empty, records that
   // name the layers. Read: refused unless they describe the file's layers (check_light_records).
   std::vector<LightRecord> light_records;
   std::int64_t samples = 0;      // prizma:samples, samples per pixel in this file
   std::string sample_range;      // prizma:sampleRange "A:B"
-  std::int64_t seed = 0;         // prizma:seed
+  std::uint64_t seed = 0;        // prizma:seed (any 64-bit seed: docs/spectral-exr.md)
   std::string scene_hash;        // prizma:sceneHash
   std::string version;           // prizma:version
   std::string wavelength_sampling;  // prizma:wavelengthSampling
@@ -106,6 +108,9 @@ struct ExrWriteOptions {
   // the calling thread (prizma-render --threads 1); n = at most n chunks in flight. The file is the
   // same byte for byte whatever the count.
   int threads = 0;
+  // Written into this group of the run's outputs (output_group.h), to appear at its commit(); null:
+  // in place when this call returns.
+  OutputGroup* group = nullptr;
 };
 
 // Writes atomically (temporary file in the same folder, then rename): a failure never leaves a partial

@@ -21,7 +21,8 @@ constexpr int kExitUsage = 2;
 // Runs body() and maps what it throws. body returns the exit code. Then flushes standard output:
 // a write error there (a full disk, /dev/full) turns exit 0 into 1 with
 // "prog: error: standard output: cannot write: <reason>". SIGXFSZ is ignored, so a file-size limit
-// fails the write (exit 1) instead of killing the tool.
+// fails the write (exit 1) instead of killing the tool. While body() runs, the files it reads are
+// recorded (InputRecording, input_file.h): no output of the run may replace one.
 int run_tool(const std::string& program, const std::function<int()>& body);
 
 // The standard output check of run_tool on its own (for --help / --version): returns `rc`, or

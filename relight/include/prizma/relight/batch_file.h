@@ -20,7 +20,9 @@ struct BatchOutput {
 std::vector<BatchOutput> read_batch_file(const std::filesystem::path& path, const RelightSession& session,
                                          const RelightSettings& base);
 
-// Relights and writes each output in turn; `log` (may be null) gets one line per file with its time.
-void run_batch(RelightSession& session, const std::vector<BatchOutput>& outputs, std::ostream* log);
+// Relights and writes each output in turn into `group` (the run's outputs: none appears before its
+// commit(); null: each as it is written); `log` (may be null) gets one line per file with its time.
+void run_batch(RelightSession& session, const std::vector<BatchOutput>& outputs, std::ostream* log,
+               spectral::OutputGroup* group = nullptr);
 
 }  // namespace prizma::relight

@@ -14,6 +14,7 @@
 #include "prizma/relight/xyz_image.h"
 #include "prizma/spectral/display.h"
 #include "prizma/spectral/image_io.h"
+#include "prizma/spectral/output_group.h"
 
 namespace prizma::relight {
 
@@ -57,9 +58,11 @@ std::optional<spectral::PictureColourSpace> display_colour_space(const spectral:
                                                                  const std::string& name);
 
 // Writes the image (display transform for PNG/TIFF; for EXR only when colour_space is set).
-// Written atomically; throws InputError for bad paths or options, RuntimeError (naming the path and
-// OpenImageIO's message) for write failures.
-void write_output_image(const std::filesystem::path& path, const XyzImage& image,
-                        const OutputOptions& opts, const ImageMetadata& metadata);
+// Written atomically, or into `group` (the run's outputs, appearing at its commit()); throws
+// InputError (naming `input`) for bad paths (check_output_path) or options, RuntimeError (naming the
+// path and OpenImageIO's message) for write failures.
+void write_output_image(const std::filesystem::path& path, const XyzImage& image, const OutputOptions& opts,
+                        const ImageMetadata& metadata, const std::string& input = "--output",
+                        spectral::OutputGroup* group = nullptr);
 
 }  // namespace prizma::relight

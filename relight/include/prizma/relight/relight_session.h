@@ -92,8 +92,11 @@ class RelightSession {
 
   ProbeResult probe(int x, int y);
   CompareResult compare(int x1, int y1, int x2, int y2, int radius = 0);
-  // Writes the current image (format by extension), with metadata().
-  void save(const std::filesystem::path& path);
+  // Writes the current image (format by extension), with metadata(): atomically, or into `group`
+  // (the run's outputs, appearing at its commit()). InputError names `input` (the option, the shell
+  // command or the page's field) for a path that cannot be written, one the run reads among them.
+  void save(const std::filesystem::path& path, const std::string& input = "--output",
+            spectral::OutputGroup* group = nullptr);
   // Attributes describing how the image was made.
   ImageMetadata metadata() const;
   // One line per layer: "name: spec".

@@ -74,6 +74,8 @@ std::vector<Light> lights_from_image(const spectral::SpectralImage& image);
 struct PreviewOptions {
   double exposure_ev = 0.0;  // linear scale 2^exposure_ev before encoding
   std::filesystem::path spectrum_base_dir;  // csv: spectra resolve against this folder
+  // The run's group of outputs the preview joins (spectral/output_group.h); null: written at once.
+  spectral::OutputGroup* group = nullptr;
 };
 
 // Relights every light with its default spectrum (in units where D65 at scale 1 makes a perfect

@@ -171,6 +171,10 @@ SceneOverride parse_scene_override(const std::string& text);
 // `overrides` are applied to the file's JSON first, then validated by the same checks; an error in
 // an overridden field names it as "-D <field path>". They are part of the scene's hash.
 Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverride>& overrides = {});
+// The same for a scene's JSON text held in memory (the Python module's render(dict)): errors name
+// `input` ("scene: materials[0].albedo: …") and relative paths resolve against `base_dir`.
+Scene load_scene_text(const std::string& text, const std::string& input, const std::filesystem::path& base_dir,
+                      const std::vector<SceneOverride>& overrides = {});
 
 // A command-line value for an integer scene field ("camera.width", "camera.height", "samples",
 // "seed", "max_bounces"), checked exactly as load_scene checks the field (same type, same range).

@@ -1,0 +1,41 @@
+#pragma once
+// What module.cpp and render_call.cpp share (the Python module prizma._prizma, docs/python.md).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "prizma/spectral/spectral_exr.h"
+
+namespace prizma::python {
+
+namespace py = pybind11;
+
+// A numpy array that owns `values` (moved, not copied): the array's base is a capsule that deletes
+// the vector when numpy lets go of it.
+template <typename T>
+py::array_t<T> take_vector(std::vector<T>&& values, std::vector<py::ssize_t> shape) {
+  auto* owner = new std::vector<T>(std::move(values));
+  py::capsule base(owner, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(std::move(shape), owner->data(), base);
+}
+
+// An integer argument the way the tools take an option: a Python int's decimal text, to be checked
+// by the same code as the option (scene_integer_override, scene_seed_override). Anything else (a
+// bool, a float, a string) is InputError(name, "must be an integer (got …)").
+std::string integer_text(const py::handle& value, const std::string& name);
+
+// A SpectralImage as the dict prizma.Image wraps (its arrays own the image's buffers, moved).
+py::dict image_to_py(spectral::SpectralImage&& image);
+
+// prizma._prizma.render (render_call.cpp): scene is a scene file's path or, with scene_is_json, a
+// scene's JSON text whose relative paths resolve against base_dir (nothing is written).
+py::dict render_scene(const std::string& scene, bool scene_is_json, const std::string& base_dir,
+                      const py::object& samples, const py::object& threads, const py::object& seed,
+                      const py::object& width, const py::object& height, const std::optional<std::string>& bins,
+                      bool variance, const py::object& samples_per_pass, const py::object& progress);
+
+}  // namespace prizma::python
