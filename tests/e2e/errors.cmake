@@ -94,6 +94,13 @@ if(TARGET prizma-render)
   prizma_render_error(scene_density_huge scene_density_huge.json "materials\\[0\\]\\.extinction" "reaches 5000000 per unit length")
   prizma_render_error(tf_huge_png tf_huge_png.json "transfer_function\\.image" "8192×8192")
   prizma_render_error(tf_truncated_png tf_truncated_png.json "transfer_function\\.image" "cannot read image")
+  # A TIFF, JPEG or EXR cut in half (the TIFF and the JPEG rendered, their missing rows read as 0).
+  foreach(_ext tif jpg exr)
+    prizma_render_error(tf_truncated_${_ext} tf_truncated_${_ext}.json "transfer_function\\.image"
+                        "cannot read image tf_truncated\\.${_ext}: ")
+    prizma_render_error(light_sky_truncated_${_ext} light_sky_truncated_${_ext}.json "lights\\[0\\]\\.environment"
+                        "cannot read image sky_truncated\\.${_ext}: ")
+  endforeach()
   # NIfTI headers the format refuses (they were read as pixdim 1, unchecked, shifted).
   prizma_render_error(nifti_pixdim_zero nifti_pixdim_zero_nii.json "pixdim_zero\\.nii" "pixdim\\[2\\]")
   prizma_render_error(nifti_vox_offset nifti_vox_offset_negative_nii.json "vox_offset_negative\\.nii" "vox_offset")
