@@ -23,6 +23,7 @@
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/input_file.h"
+#include "prizma/spectral/light_spectrum.h"
 #include "prizma/spectral/spectrum_spec.h"
 
 namespace prizma::render {
@@ -43,6 +44,11 @@ constexpr std::int64_t kMaxSamples = std::int64_t{1} << 40;
 constexpr std::int64_t kMaxBounces = 1000000;
 constexpr double kMaxDensity = 1e30;
 constexpr double kMaxExtinctionPerUnit = 1e6;
+// Emitted radiance Le at density 1: the tracer adds w·σa·density·Le/μ̄ per collision in float, with
+// σt·density ≤ kMaxExtinctionPerUnit, so each term stays below 10¹² and a path's sum over its at most
+// 2²⁸ steps below 10²¹ (3e38, float's largest, became NaN and then no light). A brighter emitter is
+// the emission layer relit with a larger scale (--light emission=D65*1000).
+constexpr double kMaxEmission = 1e6;
 // Point-light positions and radii: |coordinate| ≤ this (the volume's largest side is 1 unit).
 constexpr double kMaxLightCoordinate = 1e6;
 
@@ -430,6 +436,10 @@ TransferFunction read_materials(const Reader& rd, const json& j, const ValueNorm
         rd.fail(emp, "must be ≥ 0 and finite at every wavelength (got values in [" + num(m.emission.min_value()) +
                          ", " + num(m.emission.max_value()) + "])");
       }
+      if (m.emission.max_value() > kMaxEmission) {
+        rd.fail(emp, "must be at most " + num(kMaxEmission) + " at every wavelength (got " + num(m.emission.max_value()) +
+                         "); scale the emission layer when relighting instead (--light NAME=SPEC*factor)");
+      }
     }
     if (mj.contains("fluorescence")) read_fluorescence(rd, mj.at("fluorescence"), Reader::join(mp, "fluorescence"), m);
 
@@ -675,7 +685,8 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
     if (lj.contains("spectrum")) {
       const std::string sp = Reader::join(lp, "spectrum");
       l.spectrum_spec = rd.string(lj.at("spectrum"), sp);
-      rd.spectrum(lj.at("spectrum"), sp);  // validate now
+      rd.spectrum(lj.at("spectrum"), sp);  // validate now, the scale bound of a light included
+      spectral::parse_light_spectrum(l.spectrum_spec, {rd.input(sp), rd.base_dir()});
       l.spectrum_spec = absolute_spec(l.spectrum_spec, rd.base_dir());
     }
     lights.push_back(std::move(l));

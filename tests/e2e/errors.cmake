@@ -92,6 +92,9 @@ if(TARGET prizma-render)
   # pixels than it holds (1.2 GB before it was refused), a truncated PNG (four lines).
   prizma_render_error(scene_extinction_huge scene_extinction_huge.json "materials\\[0\\]\\.extinction" "extinction × density reaches 1e\\+39")
   prizma_render_error(scene_density_huge scene_density_huge.json "materials\\[0\\]\\.extinction" "reaches 5000000 per unit length")
+  # Light that overflowed into no light: emission 3e38 (NaN, counted as 0), a default spectrum D65*1e39.
+  prizma_render_error(scene_emission_huge scene_emission_huge.json "materials\\[0\\]\\.emission" "must be at most 1000000 at every wavelength \\(got 3e\\+38\\)")
+  prizma_render_error(scene_light_scale_huge scene_light_scale_huge.json "lights\\[0\\]\\.spectrum" "light scale 1e\\+39 in \"D65\\*1e39\" is above 1e\\+12")
   prizma_render_error(tf_huge_png tf_huge_png.json "transfer_function\\.image" "8192×8192")
   prizma_render_error(tf_truncated_png tf_truncated_png.json "transfer_function\\.image" "cannot read image")
   # A TIFF, JPEG or EXR cut in half (the TIFF and the JPEG rendered, their missing rows read as 0).
@@ -154,6 +157,8 @@ if(TARGET prizma-relight)
   # Light spectra: outside the colour matching range, unsorted CSV.
   prizma_error_e2e(relight_light_outside_bins prizma-relight 2 "light" "no energy" relight_light_ir.png
                    good.exr --light csv:infrared.csv -o relight_light_ir.png)
+  prizma_error_e2e(relight_light_scale_huge prizma-relight 2 "\\-\\-light:" "light scale 1e\\+39 in \"D65\\*1e39\" is above 1e\\+12"
+                   relight_light_scale.png good.exr --light D65*1e39 -o relight_light_scale.png)
   prizma_error_e2e(relight_light_far_infrared prizma-relight 2 "light" "no energy" relight_light_ir2.png
                    good.exr --light gaussian:1200:10 -o relight_light_ir2.png)
   prizma_error_e2e(relight_light_unsorted_csv prizma-relight 2 "unsorted\\.csv" "increasing" relight_light_unsorted.png
