@@ -621,6 +621,7 @@ py::dict render_scene(const std::string& scene_path, std::optional<std::int64_t>
   s["samples_completed"] = stats.samples_completed;
   s["interrupted"] = stats.interrupted;
   s["wall_seconds"] = stats.wall_seconds;
+  s["warnings"] = scene.warnings;  // what a library noticed in an input it still read (an OpenVDB file)
   out["stats"] = s;
   return out;
 }

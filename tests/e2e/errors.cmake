@@ -120,6 +120,30 @@ if(TARGET prizma-render)
   # A spectrum outside the bins is zero there by definition (spectrum.h), so a material or a light's
   # default spectrum that misses the bins is valid for the renderer; prizma-relight refuses a light
   # with no energy inside the bins (below).
+  # Damaged OpenVDB files (issue 21): a valid cloud from prizma-make-cloud-vdb cut short or with one
+  # byte changed (a size that then asks for terabytes was "out of memory", exit 1), and a real level
+  # set (taken as density before). Written by make-vdb-fixtures (fixture errors_vdb_files).
+  if(TARGET prizma-make-cloud-vdb)
+    add_executable(prizma_test_make_level_set_vdb ${_errors_dir}/make_level_set_vdb.cpp)
+    target_link_libraries(prizma_test_make_level_set_vdb PRIVATE prizma_openvdb)
+    prizma_set_warnings(prizma_test_make_level_set_vdb)
+    prizma_sanitizer_ignorelist(${_errors_dir}/make_level_set_vdb.cpp)  # OpenVDB's trees: see vdb/CMakeLists.txt
+    add_test(NAME errors.e2e.vdb_fixtures
+             COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/make-vdb-fixtures ${_errors_work}
+                     $<TARGET_FILE:prizma-make-cloud-vdb> $<TARGET_FILE:prizma_test_make_level_set_vdb>)
+    set_tests_properties(errors.e2e.vdb_fixtures PROPERTIES FIXTURES_SETUP errors_vdb_files LABELS errors)
+    function(prizma_vdb_error name input reason)
+      prizma_render_error(${name} ${name}.json "${input}" "${reason}")
+      set_tests_properties(errors.e2e.render_${name} PROPERTIES FIXTURES_REQUIRED "errors_files;errors_vdb_files")
+    endfunction()
+    prizma_vdb_error(vdb_truncated "vdb_truncated\\.vdb" "not a readable OpenVDB file \\(.*Expected to")
+    prizma_vdb_error(vdb_truncated_header "vdb_truncated_header\\.vdb" "no grid named \"density\" \\(the file holds no grids: empty, or cut short\\)")
+    if(NOT PRIZMA_SANITIZE AND NOT PRIZMA_FUZZ)  # AddressSanitizer aborts on the size before OpenVDB can throw
+      prizma_vdb_error(vdb_flipped_size "vdb_flipped_size\\.vdb"
+                       "not a readable OpenVDB file \\(corrupt: a size in it asks for more memory than any valid file of 42125 bytes needs\\)")
+    endif()
+    prizma_vdb_error(vdb_level_set "vdb_level_set\\.vdb: grid \"density\"" "is a level set .*convert it to a fog volume first")
+  endif()
 endif()
 
 if(TARGET prizma-relight)
