@@ -4,9 +4,11 @@
 
 #include <poll.h>
 #include <pty.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -182,6 +184,39 @@ TEST(TerminalImage, QueryOnAPseudoTerminal) {
   ASSERT_EQ(::pipe(pipefd), 0);
   EXPECT_EQ(query_image_protocol(pipefd[0], pipefd[1], 5000), ImageProtocol::Blocks);
   for (int fd : {master, slave, pipefd[0], pipefd[1]}) ::close(fd);
+}
+
+// issue 21: a terminal that answered after 300 ms (tmux on a loaded machine) had its reply read by
+// the line editor as typed keys ("1;2cquit: unknown command"), so relight.e2e.shell_terminal failed
+// under load. The query waits for the reply itself: one that comes 800 ms late is read by the query,
+// and nothing is left on the terminal's input.
+TEST(TerminalImage, ALateReplyIsReadByTheQueryNotLeftAsTypedKeys) {
+  int master = -1, slave = -1;
+  ASSERT_EQ(::openpty(&master, &slave, nullptr, nullptr, nullptr), 0);
+  std::thread terminal([master] {
+    std::string seen;
+    char buf[256];
+    while (seen.find("\x1b[5n") == std::string::npos) {
+      pollfd p{master, POLLIN, 0};
+      if (::poll(&p, 1, 5000) <= 0) return;
+      const ssize_t n = ::read(master, buf, sizeof buf);
+      if (n <= 0) return;
+      seen.append(buf, static_cast<std::size_t>(n));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));  // a busy terminal
+    const std::string reply = "\x1b[?1;2c\x1b[0n";                // tmux's
+    EXPECT_EQ(::write(master, reply.data(), reply.size()), static_cast<ssize_t>(reply.size()));
+  });
+  EXPECT_EQ(query_image_protocol(slave, slave), ImageProtocol::Blocks);
+  terminal.join();
+  // As the line editor reads it (raw: a reply has no newline for canonical mode to deliver).
+  termios raw{};
+  ASSERT_EQ(::tcgetattr(slave, &raw), 0);
+  raw.c_lflag &= ~static_cast<tcflag_t>(ICANON | ECHO);
+  ASSERT_EQ(::tcsetattr(slave, TCSANOW, &raw), 0);
+  pollfd left{slave, POLLIN, 0};
+  EXPECT_EQ(::poll(&left, 1, 0), 0) << "the reply was left on the terminal's input";
+  for (int fd : {master, slave}) ::close(fd);
 }
 
 std::vector<float> solid(int w, int h, float r, float g, float b) {
