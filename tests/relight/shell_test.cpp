@@ -157,26 +157,30 @@ TEST(TerminalImage, ProtocolFromReplies) {
   EXPECT_EQ(image_protocol_from_replies("\x1b[?62;4"), ImageProtocol::Blocks);  // cut short
 }
 
+// The terminal's side of the query on the pseudo-terminal `master`: reads up to the status report
+// request (DSR), waits `delay`, then writes `reply`.
+void answer_query(int master, const std::string& reply, std::chrono::milliseconds delay = {}) {
+  std::string seen;
+  char buf[256];
+  while (seen.find("\x1b[5n") == std::string::npos) {
+    pollfd p{master, POLLIN, 0};
+    if (::poll(&p, 1, 5000) <= 0) return;
+    const ssize_t n = ::read(master, buf, sizeof buf);
+    if (n <= 0) return;
+    seen.append(buf, static_cast<std::size_t>(n));
+  }
+  std::this_thread::sleep_for(delay);
+  EXPECT_EQ(::write(master, reply.data(), reply.size()), static_cast<ssize_t>(reply.size()));
+}
+
 // The query on a real pseudo-terminal: with nobody answering it gives up (Blocks) instead of hanging;
 // with a terminal answering DA1 with attribute 4 it finds sixel.
 TEST(TerminalImage, QueryOnAPseudoTerminal) {
   int master = -1, slave = -1;
   ASSERT_EQ(::openpty(&master, &slave, nullptr, nullptr, nullptr), 0);
   EXPECT_EQ(query_image_protocol(slave, slave, 100), ImageProtocol::Blocks);
-  std::thread terminal([master] {
-    // Read the query, then answer as a sixel terminal would.
-    std::string seen;
-    char buf[256];
-    while (seen.find("\x1b[5n") == std::string::npos) {
-      pollfd p{master, POLLIN, 0};
-      if (::poll(&p, 1, 5000) <= 0) return;
-      const ssize_t n = ::read(master, buf, sizeof buf);
-      if (n <= 0) return;
-      seen.append(buf, static_cast<std::size_t>(n));
-    }
-    const std::string reply = "\x1b[?62;4;22c\x1b[0n";
-    EXPECT_EQ(::write(master, reply.data(), reply.size()), static_cast<ssize_t>(reply.size()));
-  });
+  // Read the query, then answer as a sixel terminal would.
+  std::thread terminal([master] { answer_query(master, "\x1b[?62;4;22c\x1b[0n"); });
   EXPECT_EQ(query_image_protocol(slave, slave, 5000), ImageProtocol::Sixel);
   terminal.join();
   // Not a terminal at all: no query.
@@ -193,20 +197,8 @@ TEST(TerminalImage, QueryOnAPseudoTerminal) {
 TEST(TerminalImage, ALateReplyIsReadByTheQueryNotLeftAsTypedKeys) {
   int master = -1, slave = -1;
   ASSERT_EQ(::openpty(&master, &slave, nullptr, nullptr, nullptr), 0);
-  std::thread terminal([master] {
-    std::string seen;
-    char buf[256];
-    while (seen.find("\x1b[5n") == std::string::npos) {
-      pollfd p{master, POLLIN, 0};
-      if (::poll(&p, 1, 5000) <= 0) return;
-      const ssize_t n = ::read(master, buf, sizeof buf);
-      if (n <= 0) return;
-      seen.append(buf, static_cast<std::size_t>(n));
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(800));  // a busy terminal
-    const std::string reply = "\x1b[?1;2c\x1b[0n";                // tmux's
-    EXPECT_EQ(::write(master, reply.data(), reply.size()), static_cast<ssize_t>(reply.size()));
-  });
+  // tmux's reply, from a busy terminal.
+  std::thread terminal([master] { answer_query(master, "\x1b[?1;2c\x1b[0n", std::chrono::milliseconds(800)); });
   EXPECT_EQ(query_image_protocol(slave, slave), ImageProtocol::Blocks);
   terminal.join();
   // As the line editor reads it (raw: a reply has no newline for canonical mode to deliver).

@@ -108,13 +108,15 @@ TEST(Clip, MajorantGridZeroesOnlyCellsWhollyCutAway) {
   EXPECT_GT(zero, 0);
 }
 
+// A scene file in `dir` of a 4³ homogeneous box with the clip planes `clip` (JSON).
+std::filesystem::path clip_scene(const ScratchDir& dir, const std::string& clip) {
+  return dir.write("s.json", R"({"volume": {"type": "procedural", "name": "homogeneous_box", "resolution": 4, "clip": )" +
+                                 clip + R"(}, "materials": [{"albedo": 0.5, "extinction": 1}], "lights": [{"name": "env", "direction": [0, 0, 0]}]})");
+}
+
 TEST(Clip, SceneFieldsAndErrors) {
   ScratchDir dir;
-  auto scene = [&](const std::string& clip) {
-    dir.write("s.json", R"({"volume": {"type": "procedural", "name": "homogeneous_box", "resolution": 4, "clip": )" + clip +
-                            R"(}, "materials": [{"albedo": 0.5, "extinction": 1}], "lights": [{"name": "env", "direction": [0, 0, 0]}]})");
-    return dir / "s.json";
-  };
+  auto scene = [&](const std::string& clip) { return clip_scene(dir, clip); };
   const Scene s = load_scene(scene(R"([{"normal": [0, 0, 2], "offset": 0.5}, {"normal": [1, 0, 0]}])"));
   ASSERT_EQ(s.medium.clip.size(), 2u);
   EXPECT_DOUBLE_EQ(s.medium.clip[0].normal.z(), 1.0);  // normalised with its offset: 2z > 0.5 ⇔ z > 0.25
@@ -141,11 +143,7 @@ TEST(Clip, SceneFieldsAndErrors) {
 // as written, an offset that becomes ±inf included (1e-300·z > 1e10 holds for no finite point).
 TEST(Clip, TinyAndHugeNormalsKeepTheirPlane) {
   ScratchDir dir;
-  auto scene = [&](const std::string& clip) {
-    dir.write("s.json", R"({"volume": {"type": "procedural", "name": "homogeneous_box", "resolution": 4, "clip": )" + clip +
-                            R"(}, "materials": [{"albedo": 0.5, "extinction": 1}], "lights": [{"name": "env", "direction": [0, 0, 0]}]})");
-    return dir / "s.json";
-  };
+  auto scene = [&](const std::string& clip) { return clip_scene(dir, clip); };
   const Scene s = load_scene(scene(R"([{"normal": [1e-300, 0, 0], "offset": 1e-301},
                                        {"normal": [1e300, 1e300, 0], "offset": 0},
                                        {"normal": [0, 0, 1e-300], "offset": 1e10}])"));
