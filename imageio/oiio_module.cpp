@@ -4,6 +4,7 @@
 #include <OpenImageIO/imageio.h>
 #include <lcms2.h>
 
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -103,16 +104,47 @@ std::vector<unsigned char> icc_profile(const PictureColourSpace& cs, std::string
 }
 
 // The last error OpenImageIO holds (the reader's, else the global one), on one line; both are
-// cleared, so that nothing is left for OpenImageIO to print at exit.
+// cleared, so that nothing is left for OpenImageIO to print at exit. A reader records one line per
+// failed strip or scanline (a TIFF cut in half: one per missing strip), so the line keeps the first
+// kShownLines and counts the rest.
 std::string one_line_error(OIIO::ImageInput* in) {
+  constexpr int kShownLines = 3;
   std::string e = in != nullptr ? in->geterror() : std::string();
   const std::string global = OIIO::geterror();
   if (e.empty()) e = global;
-  for (char& c : e) {
-    if (c == '\n' || c == '\r') c = ' ';
+  std::string line;
+  int lines = 0;
+  std::size_t start = 0;
+  while (start < e.size()) {
+    std::size_t end = e.find_first_of("\r\n", start);
+    if (end == std::string::npos) end = e.size();
+    std::string part = e.substr(start, end - start);
+    while (!part.empty() && part.back() == ' ') part.pop_back();
+    if (!part.empty() && ++lines <= kShownLines) line += (line.empty() ? "" : " ") + part;
+    start = end + 1;
   }
-  while (!e.empty() && e.back() == ' ') e.pop_back();
-  return e.empty() ? "unknown error" : e;
+  if (lines > kShownLines) line += " (and " + std::to_string(lines - kShownLines) + " more messages)";
+  return line.empty() ? "unknown error" : line;
+}
+
+// Formats whose OpenImageIO writer embeds an "ICCProfile" attribute in the file. Others (OpenEXR,
+// HDR, …) have no place for one: OpenEXR's writer would print "Don't know what to do with …
+// ICCProfile" and drop it.
+bool embeds_icc_profile(const OIIO::ImageOutput& image) {
+  const std::string format = image.format_name();
+  return format == "png" || format == "tiff" || format == "jpeg";
+}
+
+// OpenImageIO's debug messages ("OIIO DEBUG: …") go to stderr in Debian's build, in successful runs
+// too; they are for OpenImageIO's developers. Off, unless the user asked for them with
+// OPENIMAGEIO_DEBUG (OpenImageIO's own variable).
+void quiet_library_debug_messages() {
+  static const bool done = [] {
+    const char* asked = std::getenv("OPENIMAGEIO_DEBUG");
+    if (asked == nullptr || *asked == '\0') OIIO::attribute("debug", 0);
+    return true;
+  }();
+  (void)done;
 }
 
 class OiioReader final : public PictureReader {
@@ -125,8 +157,12 @@ class OiioReader final : public PictureReader {
   int height() const override { return m_spec.height; }
   int channels() const override { return m_spec.nchannels; }
   std::size_t channel_bytes() const override { return m_spec.format.size(); }
+  // A reader that hits the end of a truncated file may still return true, with the rows it could
+  // not decode left as zeros (TIFF, JPEG: "Premature end of JPEG file"): any error it recorded
+  // fails the read.
   bool read_float(float* pixels, std::string& error) override {
-    if (m_in->read_image(0, 0, 0, m_spec.nchannels, OIIO::TypeDesc::FLOAT, pixels)) return true;
+    const bool read = m_in->read_image(0, 0, 0, m_spec.nchannels, OIIO::TypeDesc::FLOAT, pixels);
+    if (read && !m_in->has_error()) return true;
     error = one_line_error(m_in.get());
     return false;
   }
@@ -154,16 +190,16 @@ class OiioModule final : public mod::Module {
     for (const auto& [key, values] : ps.float_attributes) {
       spec.attribute(key, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, static_cast<int>(values.size())), values.data());
     }
-    if (ps.colour_space) {
-      const std::vector<unsigned char> icc = icc_profile(*ps.colour_space, reason);
-      if (icc.empty()) return mod::WriteStatus::Failed;
-      spec.attribute("ICCProfile", OIIO::TypeDesc(OIIO::TypeDesc::UINT8, static_cast<int>(icc.size())), icc.data());
-    }
     SinkProxy proxy(filename, sink);
     std::unique_ptr<OIIO::ImageOutput> image = OIIO::ImageOutput::create(filename, &proxy);
     if (!image) {
       reason = OIIO::geterror();
       return mod::WriteStatus::UnknownFormat;
+    }
+    if (ps.colour_space && embeds_icc_profile(*image)) {
+      const std::vector<unsigned char> icc = icc_profile(*ps.colour_space, reason);
+      if (icc.empty()) return mod::WriteStatus::Failed;
+      spec.attribute("ICCProfile", OIIO::TypeDesc(OIIO::TypeDesc::UINT8, static_cast<int>(icc.size())), icc.data());
     }
     if (!image->supports("ioproxy")) return mod::WriteStatus::NoIoProxy;
     const auto fail = [&](const char* what) {
@@ -194,6 +230,7 @@ class OiioModule final : public mod::Module {
 }  // namespace
 
 extern "C" __attribute__((visibility("default"))) const mod::Module* prizma_image_io_module_v1() {
+  quiet_library_debug_messages();
   static const OiioModule module;
   return &module;
 }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "prizma/spectral/error.h"
+#include "text_util.h"
 
 namespace prizma::spectral {
 
@@ -47,6 +48,11 @@ LightSpectrum parse_light_spectrum(std::string_view text, const SpecContext& ctx
     }
     out.scale *= factor;
     base = trim(base.substr(0, star));
+  }
+  if (!(out.scale <= kMaxLightScale)) {
+    throw InputError(ctx.input, "light scale " + detail::format_double(out.scale) + " in \"" + out.text + "\" is above " +
+                                    detail::format_double(kMaxLightScale) +
+                                    ", the most a relight can apply without overflowing (--exposure adds up to 64 stops)");
   }
   if (base == "off") {
     out.off = true;

@@ -191,6 +191,7 @@ py::dict render_scene(const std::string& scene_source, bool scene_is_json, const
   s["samples_completed"] = stats.samples_completed;
   s["interrupted"] = stats.interrupted;
   s["wall_seconds"] = stats.wall_seconds;
+  s["warnings"] = scene.warnings;  // what a library noticed in an input it still read (an OpenVDB file)
   out["stats"] = s;
   return out;
 }

@@ -1,8 +1,11 @@
 #include "prizma/relight/relight_matrix.h"
 
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include "prizma/spectral/colour.h"
+#include "prizma/spectral/error.h"
 
 namespace prizma::relight {
 
@@ -38,6 +41,14 @@ RelightMatrix::RelightMatrix(const spectral::BinLayout& bins, const std::vector<
   for (std::size_t l = 0; l < m_per_light.size(); ++l) {
     m_per_light[l] = exposure * m_adaptation * m_per_light[l];
     m_stacked.middleCols(static_cast<Eigen::Index>(l) * m_bins, m_bins) = m_per_light[l].cast<float>();
+    // Weights a float cannot hold relight as ±inf and NaN: a black image. A relative light's scale is
+    // bounded (kMaxLightScale), so this is an absolute light whose table is in very large units.
+    if (!m_stacked.middleCols(static_cast<Eigen::Index>(l) * m_bins, m_bins).allFinite()) {
+      std::ostringstream largest;
+      largest << std::setprecision(3) << m_per_light[l].cwiseAbs().maxCoeff();
+      throw spectral::InputError("light", "\"" + lights[l].text + "\": its relight weights (up to " + largest.str() +
+                                              ") overflow a float; give a smaller scale or exposure");
+    }
   }
 }
 

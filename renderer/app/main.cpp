@@ -343,6 +343,7 @@ int main(int argc, char** argv) {
     if (output.empty()) throw InputError("-o", "no output file: give -o or set \"output\" in the scene");
     check_outputs(output, !o.output.empty() ? "-o" : !o.resume.empty() ? "--resume" : o.scene + ": output", o.preview);
 
+    for (const std::string& w : scene.warnings) std::cerr << kProgram << ": warning: " << w << "\n";
     if (o.verbose) {
       std::cerr << kProgram << ": scene " << scene.source.string() << " (hash " << scene.hash << "), "
                 << scene.camera.width << "×" << scene.camera.height << ", " << st.bins.size() << " bins "

@@ -82,7 +82,9 @@ bool LightSampler::sample(const Eigen::Vector3d& p, Rng& rng, LightSample& out) 
     case Kind::Sphere: {
       // A sphere of radius R emitting radiance L = 1/(πR²) outward (intensity πR²·L = 1 in every
       // direction, power 4π as the point light's), sampled uniformly in the cone it subtends
-      // (pbrt-v4, Sphere::Sample by solid angle): pdf 1/(2π(1 − cos θmax)), value L/pdf.
+      // (pbrt-v4, Sphere::Sample by solid angle): pdf 1/(2π(1 − cos θmax)), value L/pdf =
+      // 2(1 − cos θmax)/R² = 2/(d²(1 + cos θmax)), computed in the second form: R² drops out, so a
+      // radius of 1e-200 (R² underflows to 0, and L overflows) is the point light it tends to, not NaN.
       const Eigen::Vector3d to = m_position - p;
       const double d2 = to.squaredNorm(), r2 = m_radius * m_radius;
       if (!(d2 > r2)) return false;  // inside the sphere: its surface emits outward only
@@ -95,7 +97,7 @@ bool LightSampler::sample(const Eigen::Vector3d& p, Rng& rng, LightSample& out) 
       const double b = d * cos_t;
       const double perp2 = std::max(0.0, d2 - b * b);
       out.distance = std::max(0.0, b - std::sqrt(std::max(0.0, r2 - perp2)));
-      out.value = 2.0 * one_minus_cos / r2;
+      out.value = 2.0 / (d2 * (1.0 + cos_max));
       return true;
     }
     case Kind::Environment: {

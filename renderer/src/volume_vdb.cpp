@@ -3,11 +3,13 @@
 // raw, NIfTI or procedural volume never maps OpenVDB and its libraries (start-up, docs/results.md).
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <mutex>
 #include <new>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "prizma/render/vdb_module.h"
@@ -81,6 +83,12 @@ Volume load_vdb_volume(const std::filesystem::path& path, const std::string& gri
     fail(rc, input, where, message);
   const auto close = [&m](PrizmaVdbGrid* g) { m.close_grid(g); };
   const std::unique_ptr<PrizmaVdbGrid, decltype(close)> grid(raw, close);
+  std::vector<std::string> warnings;
+  for (std::string_view rest = info.warnings; !rest.empty();) {
+    const std::size_t end = std::min(rest.find('\n'), rest.size());
+    warnings.push_back(input + ": OpenVDB: " + std::string(rest.substr(0, end)));
+    rest.remove_prefix(std::min(end + 1, rest.size()));
+  }
 
   // Dense over the active bounding box, x fastest; checked to fit before it is allocated.
   const std::array<int, 3> dims{info.dims[0], info.dims[1], info.dims[2]};
@@ -89,6 +97,7 @@ Volume load_vdb_volume(const std::filesystem::path& path, const std::string& gri
   vol.dims = dims;
   vol.spacing = {info.voxel_size[0], info.voxel_size[1], info.voxel_size[2]};
   vol.source = input;
+  vol.warnings = std::move(warnings);
   vol.values.resize(count);
   if (const int rc = m.copy_dense(grid.get(), vol.values.data(), message, sizeof message); rc != PRIZMA_VDB_OK)
     fail(rc, input, where, message);

@@ -92,8 +92,18 @@ if(TARGET prizma-render)
   # pixels than it holds (1.2 GB before it was refused), a truncated PNG (four lines).
   prizma_render_error(scene_extinction_huge scene_extinction_huge.json "materials\\[0\\]\\.extinction" "extinction × density reaches 1e\\+39")
   prizma_render_error(scene_density_huge scene_density_huge.json "materials\\[0\\]\\.extinction" "reaches 5000000 per unit length")
+  # Light that overflowed into no light: emission 3e38 (NaN, counted as 0), a default spectrum D65*1e39.
+  prizma_render_error(scene_emission_huge scene_emission_huge.json "materials\\[0\\]\\.emission" "must be at most 1000000 at every wavelength \\(got 3e\\+38\\)")
+  prizma_render_error(scene_light_scale_huge scene_light_scale_huge.json "lights\\[0\\]\\.spectrum" "light scale 1e\\+39 in \"D65\\*1e39\" is above 1e\\+12")
   prizma_render_error(tf_huge_png tf_huge_png.json "transfer_function\\.image" "8192×8192")
   prizma_render_error(tf_truncated_png tf_truncated_png.json "transfer_function\\.image" "cannot read image")
+  # A TIFF, JPEG or EXR cut in half (the TIFF and the JPEG rendered, their missing rows read as 0).
+  foreach(_ext tif jpg exr)
+    prizma_render_error(tf_truncated_${_ext} tf_truncated_${_ext}.json "transfer_function\\.image"
+                        "cannot read image tf_truncated\\.${_ext}: ")
+    prizma_render_error(light_sky_truncated_${_ext} light_sky_truncated_${_ext}.json "lights\\[0\\]\\.environment"
+                        "cannot read image sky_truncated\\.${_ext}: ")
+  endforeach()
   # NIfTI headers the format refuses (they were read as pixdim 1, unchecked, shifted).
   prizma_render_error(nifti_pixdim_zero nifti_pixdim_zero_nii.json "pixdim_zero\\.nii" "pixdim\\[2\\]")
   prizma_render_error(nifti_vox_offset nifti_vox_offset_negative_nii.json "vox_offset_negative\\.nii" "vox_offset")
@@ -110,6 +120,30 @@ if(TARGET prizma-render)
   # A spectrum outside the bins is zero there by definition (spectrum.h), so a material or a light's
   # default spectrum that misses the bins is valid for the renderer; prizma-relight refuses a light
   # with no energy inside the bins (below).
+  # Damaged OpenVDB files (issue 21): a valid cloud from prizma-make-cloud-vdb cut short or with one
+  # byte changed (a size that then asks for terabytes was "out of memory", exit 1), and a real level
+  # set (taken as density before). Written by make-vdb-fixtures (fixture errors_vdb_files).
+  if(TARGET prizma-make-cloud-vdb)
+    add_executable(prizma_test_make_level_set_vdb ${_errors_dir}/make_level_set_vdb.cpp)
+    target_link_libraries(prizma_test_make_level_set_vdb PRIVATE prizma_openvdb)
+    prizma_set_warnings(prizma_test_make_level_set_vdb)
+    prizma_sanitizer_ignorelist(${_errors_dir}/make_level_set_vdb.cpp)  # OpenVDB's trees: see vdb/CMakeLists.txt
+    add_test(NAME errors.e2e.vdb_fixtures
+             COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${_errors_dir}/make-vdb-fixtures ${_errors_work}
+                     $<TARGET_FILE:prizma-make-cloud-vdb> $<TARGET_FILE:prizma_test_make_level_set_vdb>)
+    set_tests_properties(errors.e2e.vdb_fixtures PROPERTIES FIXTURES_SETUP errors_vdb_files LABELS errors)
+    function(prizma_vdb_error name input reason)
+      prizma_render_error(${name} ${name}.json "${input}" "${reason}")
+      set_tests_properties(errors.e2e.render_${name} PROPERTIES FIXTURES_REQUIRED "errors_files;errors_vdb_files")
+    endfunction()
+    prizma_vdb_error(vdb_truncated "vdb_truncated\\.vdb" "not a readable OpenVDB file \\(.*Expected to")
+    prizma_vdb_error(vdb_truncated_header "vdb_truncated_header\\.vdb" "no grid named \"density\" \\(the file holds no grids: empty, or cut short\\)")
+    if(NOT PRIZMA_SANITIZE AND NOT PRIZMA_FUZZ)  # AddressSanitizer aborts on the size before OpenVDB can throw
+      prizma_vdb_error(vdb_flipped_size "vdb_flipped_size\\.vdb"
+                       "not a readable OpenVDB file \\(corrupt: a size in it asks for more memory than any valid file of 42125 bytes needs\\)")
+    endif()
+    prizma_vdb_error(vdb_level_set "vdb_level_set\\.vdb: grid \"density\"" "is a level set .*convert it to a fog volume first")
+  endif()
 endif()
 
 if(TARGET prizma-relight)
@@ -147,6 +181,8 @@ if(TARGET prizma-relight)
   # Light spectra: outside the colour matching range, unsorted CSV.
   prizma_error_e2e(relight_light_outside_bins prizma-relight 2 "light" "no energy" relight_light_ir.png
                    good.exr --light csv:infrared.csv -o relight_light_ir.png)
+  prizma_error_e2e(relight_light_scale_huge prizma-relight 2 "\\-\\-light:" "light scale 1e\\+39 in \"D65\\*1e39\" is above 1e\\+12"
+                   relight_light_scale.png good.exr --light D65*1e39 -o relight_light_scale.png)
   prizma_error_e2e(relight_light_far_infrared prizma-relight 2 "light" "no energy" relight_light_ir2.png
                    good.exr --light gaussian:1200:10 -o relight_light_ir2.png)
   prizma_error_e2e(relight_light_unsorted_csv prizma-relight 2 "unsorted\\.csv" "increasing" relight_light_unsorted.png

@@ -169,5 +169,49 @@ TEST(LightSpec, ParsesScalesAndOff) {
   EXPECT_THROW(parse_light_spec(""), spectral::InputError);
 }
 
+// issue 21: "D65*1e39" gave +inf weights, NaN pixels and a black image with exit 0. A light's scale is
+// at most kMaxLightScale (the product of its factors); just inside, at the largest exposure, every
+// weight and every relit value is finite and the image is not black.
+TEST(LightSpec, ScaleAboveTheBoundIsRefused) {
+  for (const char* spec : {"D65*1e39", "D65*1e13", "D65*1e7*1e6", "A*1e300*1e300"}) {
+    try {
+      parse_light_spec(spec, {"--light key", {}});
+      ADD_FAILURE() << spec;
+    } catch (const spectral::InputError& e) {
+      EXPECT_EQ(e.input(), "--light key");
+      EXPECT_NE(e.reason().find("is above 1e+12"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_DOUBLE_EQ(parse_light_spec("D65*1e6*1e6").scale, spectral::kMaxLightScale);
+  const BinLayout bins = BinLayout::linear(400.0, 700.0, 16);
+  const auto img = test::make_image(3, 3, bins, {"key"}, transport);
+  RelightOptions brightest;
+  brightest.exposure_ev = 64.0;
+  const XyzImage got = relight_image(img, RelightMatrix(bins, lights({"D65*1e12"}), brightest));
+  for (float v : got.xyz) {
+    EXPECT_TRUE(std::isfinite(v)) << v;
+    EXPECT_GT(v, 1e30f);  // T ≥ 0.05 at 1e12 × 2^64
+  }
+}
+
+// The same net for absolute units, whose weights follow the table's own values: a constant 1e30
+// at +64 EV cannot be held by a float and is refused, naming the light; relative, it is fine.
+TEST(RelightMatrix, RefusesWeightsAFloatCannotHold) {
+  const BinLayout bins = BinLayout::linear(400.0, 700.0, 16);
+  RelightOptions absolute;
+  absolute.units = spectral::LightUnits::Absolute;
+  absolute.exposure_ev = 64.0;
+  try {
+    RelightMatrix(bins, lights({"D65", "1e30"}), absolute);
+    ADD_FAILURE() << "no error";
+  } catch (const spectral::InputError& e) {
+    EXPECT_EQ(e.input(), "light");
+    EXPECT_NE(e.reason().find("\"1e30\": its relight weights"), std::string::npos) << e.what();
+  }
+  RelightOptions relative;
+  relative.exposure_ev = 64.0;
+  EXPECT_TRUE(RelightMatrix(bins, lights({"D65", "1e30"}), relative).stacked().allFinite());
+}
+
 }  // namespace
 }  // namespace prizma::relight

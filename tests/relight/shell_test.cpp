@@ -4,9 +4,11 @@
 
 #include <poll.h>
 #include <pty.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -155,26 +157,30 @@ TEST(TerminalImage, ProtocolFromReplies) {
   EXPECT_EQ(image_protocol_from_replies("\x1b[?62;4"), ImageProtocol::Blocks);  // cut short
 }
 
+// The terminal's side of the query on the pseudo-terminal `master`: reads up to the status report
+// request (DSR), waits `delay`, then writes `reply`.
+void answer_query(int master, const std::string& reply, std::chrono::milliseconds delay = {}) {
+  std::string seen;
+  char buf[256];
+  while (seen.find("\x1b[5n") == std::string::npos) {
+    pollfd p{master, POLLIN, 0};
+    if (::poll(&p, 1, 5000) <= 0) return;
+    const ssize_t n = ::read(master, buf, sizeof buf);
+    if (n <= 0) return;
+    seen.append(buf, static_cast<std::size_t>(n));
+  }
+  std::this_thread::sleep_for(delay);
+  EXPECT_EQ(::write(master, reply.data(), reply.size()), static_cast<ssize_t>(reply.size()));
+}
+
 // The query on a real pseudo-terminal: with nobody answering it gives up (Blocks) instead of hanging;
 // with a terminal answering DA1 with attribute 4 it finds sixel.
 TEST(TerminalImage, QueryOnAPseudoTerminal) {
   int master = -1, slave = -1;
   ASSERT_EQ(::openpty(&master, &slave, nullptr, nullptr, nullptr), 0);
   EXPECT_EQ(query_image_protocol(slave, slave, 100), ImageProtocol::Blocks);
-  std::thread terminal([master] {
-    // Read the query, then answer as a sixel terminal would.
-    std::string seen;
-    char buf[256];
-    while (seen.find("\x1b[5n") == std::string::npos) {
-      pollfd p{master, POLLIN, 0};
-      if (::poll(&p, 1, 5000) <= 0) return;
-      const ssize_t n = ::read(master, buf, sizeof buf);
-      if (n <= 0) return;
-      seen.append(buf, static_cast<std::size_t>(n));
-    }
-    const std::string reply = "\x1b[?62;4;22c\x1b[0n";
-    EXPECT_EQ(::write(master, reply.data(), reply.size()), static_cast<ssize_t>(reply.size()));
-  });
+  // Read the query, then answer as a sixel terminal would.
+  std::thread terminal([master] { answer_query(master, "\x1b[?62;4;22c\x1b[0n"); });
   EXPECT_EQ(query_image_protocol(slave, slave, 5000), ImageProtocol::Sixel);
   terminal.join();
   // Not a terminal at all: no query.
@@ -182,6 +188,27 @@ TEST(TerminalImage, QueryOnAPseudoTerminal) {
   ASSERT_EQ(::pipe(pipefd), 0);
   EXPECT_EQ(query_image_protocol(pipefd[0], pipefd[1], 5000), ImageProtocol::Blocks);
   for (int fd : {master, slave, pipefd[0], pipefd[1]}) ::close(fd);
+}
+
+// issue 21: a terminal that answered after 300 ms (tmux on a loaded machine) had its reply read by
+// the line editor as typed keys ("1;2cquit: unknown command"), so relight.e2e.shell_terminal failed
+// under load. The query waits for the reply itself: one that comes 800 ms late is read by the query,
+// and nothing is left on the terminal's input.
+TEST(TerminalImage, ALateReplyIsReadByTheQueryNotLeftAsTypedKeys) {
+  int master = -1, slave = -1;
+  ASSERT_EQ(::openpty(&master, &slave, nullptr, nullptr, nullptr), 0);
+  // tmux's reply, from a busy terminal.
+  std::thread terminal([master] { answer_query(master, "\x1b[?1;2c\x1b[0n", std::chrono::milliseconds(800)); });
+  EXPECT_EQ(query_image_protocol(slave, slave), ImageProtocol::Blocks);
+  terminal.join();
+  // As the line editor reads it (raw: a reply has no newline for canonical mode to deliver).
+  termios raw{};
+  ASSERT_EQ(::tcgetattr(slave, &raw), 0);
+  raw.c_lflag &= ~static_cast<tcflag_t>(ICANON | ECHO);
+  ASSERT_EQ(::tcsetattr(slave, TCSANOW, &raw), 0);
+  pollfd left{slave, POLLIN, 0};
+  EXPECT_EQ(::poll(&left, 1, 0), 0) << "the reply was left on the terminal's input";
+  for (int fd : {master, slave}) ::close(fd);
 }
 
 std::vector<float> solid(int w, int h, float r, float g, float b) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "prizma/render/majorant_grid.h"
 #include "prizma/render/render.h"
@@ -107,13 +108,15 @@ TEST(Clip, MajorantGridZeroesOnlyCellsWhollyCutAway) {
   EXPECT_GT(zero, 0);
 }
 
+// A scene file in `dir` of a 4³ homogeneous box with the clip planes `clip` (JSON).
+std::filesystem::path clip_scene(const ScratchDir& dir, const std::string& clip) {
+  return dir.write("s.json", R"({"volume": {"type": "procedural", "name": "homogeneous_box", "resolution": 4, "clip": )" +
+                                 clip + R"(}, "materials": [{"albedo": 0.5, "extinction": 1}], "lights": [{"name": "env", "direction": [0, 0, 0]}]})");
+}
+
 TEST(Clip, SceneFieldsAndErrors) {
   ScratchDir dir;
-  auto scene = [&](const std::string& clip) {
-    dir.write("s.json", R"({"volume": {"type": "procedural", "name": "homogeneous_box", "resolution": 4, "clip": )" + clip +
-                            R"(}, "materials": [{"albedo": 0.5, "extinction": 1}], "lights": [{"name": "env", "direction": [0, 0, 0]}]})");
-    return dir / "s.json";
-  };
+  auto scene = [&](const std::string& clip) { return clip_scene(dir, clip); };
   const Scene s = load_scene(scene(R"([{"normal": [0, 0, 2], "offset": 0.5}, {"normal": [1, 0, 0]}])"));
   ASSERT_EQ(s.medium.clip.size(), 2u);
   EXPECT_DOUBLE_EQ(s.medium.clip[0].normal.z(), 1.0);  // normalised with its offset: 2z > 0.5 ⇔ z > 0.25
@@ -133,6 +136,30 @@ TEST(Clip, SceneFieldsAndErrors) {
   expect_error(R"([{"normal": [0, 1]}])", "volume.clip[0].normal: must be an array of 3 numbers");
   expect_error(R"([{"normal": [0, 0, 1], "offset": "x"}])", "volume.clip[0].offset: must be a number");
   expect_error(R"([{"normal": [0, 0, 1], "side": 1}])", "volume.clip[0].side: unknown field");
+}
+
+// issue 21: a normal of norm 1e-300 (the norm underflows to 0) or 1e300 (overflows to inf) was
+// refused as "the zero vector"; scaled by its largest component first, it keeps its plane exactly
+// as written, an offset that becomes ±inf included (1e-300·z > 1e10 holds for no finite point).
+TEST(Clip, TinyAndHugeNormalsKeepTheirPlane) {
+  ScratchDir dir;
+  auto scene = [&](const std::string& clip) { return clip_scene(dir, clip); };
+  const Scene s = load_scene(scene(R"([{"normal": [1e-300, 0, 0], "offset": 1e-301},
+                                       {"normal": [1e300, 1e300, 0], "offset": 0},
+                                       {"normal": [0, 0, 1e-300], "offset": 1e10}])"));
+  ASSERT_EQ(s.medium.clip.size(), 3u);
+  EXPECT_EQ(s.medium.clip[0].normal, Eigen::Vector3d(1, 0, 0));
+  EXPECT_DOUBLE_EQ(s.medium.clip[0].offset, 0.1);  // x > 0.1 removed
+  EXPECT_TRUE(s.medium.clip[1].normal.isApprox(Eigen::Vector3d(1, 1, 0).normalized()));
+  EXPECT_EQ(s.medium.clip[1].offset, 0.0);
+  EXPECT_EQ(s.medium.clip[2].normal, Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(s.medium.clip[2].offset, std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(s.medium.clipped(Eigen::Vector3d(0.05, -0.2, 0.4)));
+  EXPECT_TRUE(s.medium.clipped(Eigen::Vector3d(0.15, -0.4, 0.0)));   // x > 0.1
+  EXPECT_TRUE(s.medium.clipped(Eigen::Vector3d(0.05, 0.1, 0.0)));    // x + y > 0
+  // The reverse: −1e-300·z > −1e10 holds for every finite point, so everything is cut away.
+  const Scene all = load_scene(scene(R"([{"normal": [0, 0, -1e-300], "offset": -1e10}])"));
+  EXPECT_TRUE(all.medium.clipped(Eigen::Vector3d(0, 0, 0.5)));
 }
 
 }  // namespace

@@ -163,5 +163,32 @@ TEST_F(EmissionScene, BadEmissionFieldsAreInputErrors) {
             std::string::npos);
 }
 
+// issue 21: emission 3e38 loaded, every path's w·σa·density·Le overflowed to inf and then NaN, and
+// the samples were counted as 0 (a warning, and no light). Le is bounded like extinction, at 10⁶;
+// at both bounds (σt = 10⁶, Le = 10⁶, albedo 0) every pixel is Le·(1 − e^{−10⁶}) = 10⁶, finite.
+TEST_F(EmissionScene, EmissionIsBoundedAndTheBoundRendersFinite) {
+  auto message = [&](const std::string& materials) {
+    try {
+      load_scene(write(materials));
+    } catch (const spectral::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  for (const char* emission : {"3e38", "1.000001e6", "\"D65*1e39\""}) {
+    const std::string m = message(std::string(R"({"albedo": 0.5, "extinction": 2, "emission": )") + emission + "}");
+    EXPECT_NE(m.find("materials[0].emission: must be at most 1000000 at every wavelength (got "), std::string::npos)
+        << emission << ": " << m;
+  }
+  Scene s = load_scene(write(R"({"albedo": 0, "extinction": 1e6, "emission": 1e6})",
+                             R"(, "camera": {"type": "orthographic", "ortho_height": 0.8, "width": 4, "height": 4},
+                                  "samples": 4)"));
+  RenderStats stats;
+  const auto img = render(s, {}, &stats);
+  EXPECT_EQ(stats.nan_or_inf_count, 0);
+  const auto em = pixel_average(img, 1);
+  for (int b = 0; b < 3; ++b) EXPECT_NEAR(em.mean[b], 1e6, 1.0) << "bin " << b;
+}
+
 }  // namespace
 }  // namespace prizma::render

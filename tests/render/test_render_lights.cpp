@@ -115,6 +115,28 @@ TEST(RenderLights, TinySphereLightIsThePointLight) {
   for (int b = 0; b < 6; ++b) EXPECT_NEAR(e.mean[b], slab_closed_form(), kSe * e.se[b]) << "bin " << b;
 }
 
+// issue 21: a sphere of radius 1e-200 (R² underflows to 0, its radiance 1/(πR²) overflows) gave
+// 0/0 = NaN for every sample (counted as 0: a silently black light). Its estimate is the point
+// light's 1/d² at every radius down to the smallest double, and it renders the closed form.
+TEST(RenderLights, VanishingSphereLightIsThePointLightNotNaN) {
+  const Eigen::Vector3d p(0.1, -0.2, 0.3);
+  const double d2 = (p - Eigen::Vector3d(0, 0, -1)).squaredNorm();
+  for (const double radius : {1e-3, 1e-80, 1e-160, 1e-200, 5e-324}) {
+    const LightSampler sampler(point_light("ball", {0, 0, -1}, radius));
+    Rng rng(5, 0, 0);
+    LightSample ls;
+    ASSERT_TRUE(sampler.sample(p, rng, ls)) << radius;
+    // 2(1 − cos θmax)/R² = 1/d² · (1 + O(R²/d²)): exact to rounding below R = 1e-8.
+    EXPECT_NEAR(ls.value, 1.0 / d2, (radius > 1e-8 ? 1e-6 : 1e-15) / d2) << radius;
+  }
+  Scene s = slab_scene(point_light("ball", {0, 0, -1}, 1e-200), 2048);
+  s.settings.seed = 23;
+  RenderStats stats;
+  const auto e = pixel_average(render(s, {}, &stats), 0);
+  EXPECT_EQ(stats.nan_or_inf_count, 0);
+  for (int b = 0; b < 6; ++b) EXPECT_NEAR(e.mean[b], slab_closed_form(), kSe * e.se[b]) << "bin " << b;
+}
+
 TEST(RenderLights, SphereLightSendsNothingInside) {
   // The sphere's surface emits outward only: a medium wholly inside it is dark.
   Scene s = slab_scene(point_light("ball", {0, 0, 0}, 2.0), 16);

@@ -531,6 +531,25 @@ TEST(SceneLoader, TinyAndHugeLightDirectionsStayDirections) {
       << s.lights[1].direction.transpose();
 }
 
+// issue 21: every direction of a scene goes through one normalisation (scaled by its largest
+// component first): a spot's axis or the camera's up of norm 1e-300 or 1e300 keeps its direction
+// (the camera's up of 1e-300 was refused as the zero vector, its
+// coordinates stay within ±1e12); [0, 0, 0] is still refused.
+TEST(SceneLoader, TinyAndHugeSpotAxesAndCameraUpKeepTheirDirection) {
+  ScratchDir dir;
+  json j = base_scene();
+  j["camera"]["up"] = {0, 1e-300, 0};
+  j["lights"][0] = {{"name", "spot"}, {"position", {0, 0, 2}},
+                    {"spot", {{"direction", {0, 0, -1e300}}, {"cone_deg", 10}}}};
+  const Scene s = load_scene(write_scene(dir, j));
+  EXPECT_EQ(s.camera.up, Eigen::Vector3d(0, 1, 0));
+  EXPECT_EQ(s.lights[0].spot_direction, Eigen::Vector3d(0, 0, -1));
+  j["camera"]["up"] = {1e-200, 0, 1e-200};
+  EXPECT_TRUE(load_scene(write_scene(dir, j)).camera.up.isApprox(Eigen::Vector3d(1, 0, 1).normalized()));
+  j["camera"]["up"] = {0, 0, 0};
+  expect_error(dir, j, "camera.up", "must not be the zero vector");
+}
+
 // issue 11: an extinction (or extinction × density) beyond what the tracker can step through
 // passed validation and the render never ended.
 TEST(SceneLoader, RefusesExtinctionTheTrackerCannotRepresent) {

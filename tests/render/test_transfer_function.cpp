@@ -14,6 +14,7 @@
 #include <iterator>
 #include <limits>
 
+#include "prizma/render/environment_map.h"
 #include "prizma/spectral/error.h"
 #include "test_scene_util.h"
 
@@ -288,6 +289,42 @@ TEST(TransferFunctionImage, TruncatedPngIsOneError) {
   EXPECT_NE(msg.find("cannot read image"), std::string::npos) << msg;
   EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   EXPECT_EQ(printed, "");
+}
+
+// issue 21: a TIFF or a JPEG cut in half rendered with exit 0, the rows the reader could not decode
+// left as zeros (OpenImageIO's read_image returned true with the error recorded). Every format
+// through both readers of scene images (transfer function, environment map): refused, on one line
+// naming the file, with nothing printed besides.
+TEST(PictureReading, TruncatedImagesOfEveryFormatAreRefused) {
+  ScratchDir dir;
+  constexpr int kW = 48, kH = 256;  // 256 rows: a TIFF of many strips, one reader message per strip
+  std::vector<unsigned char> px(static_cast<std::size_t>(kW) * kH * 3);
+  for (std::size_t i = 0; i < px.size(); ++i) px[i] = static_cast<unsigned char>(1 + (i * 7919) % 250);
+  for (const std::string ext : {"tif", "jpg", "png", "exr"}) {
+    const auto full = dir / ("full." + ext);
+    write_png(full, kW, kH, px);
+    std::ifstream in(full, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto cut = dir.write("cut." + ext, bytes.substr(0, bytes.size() / 2));
+    EXPECT_EQ(tf_error(full), "no error") << ext;
+    EXPECT_NO_THROW(EnvironmentMap::load(full, 0.0, "sky")) << ext;
+
+    ::testing::internal::CaptureStderr();
+    const std::string msg = tf_error(cut);
+    std::string env_msg = "no error";
+    try {
+      EnvironmentMap::load(cut, 0.0, "sky");
+    } catch (const InputError& e) {
+      env_msg = e.what();
+    }
+    const std::string printed = ::testing::internal::GetCapturedStderr();
+    for (const std::string& m : {msg, env_msg}) {
+      EXPECT_NE(m.find("cannot read image " + cut.string() + ": "), std::string::npos) << ext << ": " << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+      EXPECT_LT(m.size(), 800u) << m;  // the first reader messages, the rest counted
+    }
+    EXPECT_EQ(printed, "") << ext;
+  }
 }
 
 }  // namespace

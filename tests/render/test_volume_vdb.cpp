@@ -5,10 +5,15 @@
 // (3 standard errors, fixed seeds); and the one-line errors.
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetSphere.h>
+#include <openvdb/tools/LevelSetUtil.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <limits>
+#include <typeinfo>
 
 #include "prizma/render/majorant_grid.h"
 #include "prizma/render/render.h"
@@ -17,6 +22,12 @@
 #include "prizma/spectral/error.h"
 #include "render_test_scenes.h"
 #include "test_scene_util.h"
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define PRIZMA_TEST_ASAN 1
+#endif
+#endif
 
 namespace prizma::render {
 namespace {
@@ -251,6 +262,83 @@ TEST(VdbVolume, BadFilesAndGridsAreOneLineInputErrors) {
   expect_input_error(dir / "g.vdb", "labels", "grid \"labels\": is of type int32, not float");
   expect_input_error(dir / "g.vdb", "empty", "grid \"empty\": has no active voxels (empty grid)");
   expect_input_error(dir / "g.vdb", "rotated", "rotated or sheared transform");
+}
+
+// issue 21: a level set (signed distances, negative inside) was read as density, a hollow shell of
+// its narrow band. It is refused, saying what to do; what it says to do (sdfToFogVolume) then reads.
+TEST(VdbVolume, LevelSetIsRefusedAndItsFogVolumeReads) {
+  ScratchDir dir;
+  init_vdb();
+  auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.3f, openvdb::Vec3f(0.0f), 0.02f, 3.0f);
+  sphere->setName("density");
+  write_grids(dir / "level_set.vdb", {sphere});
+  expect_input_error(dir / "level_set.vdb", "density",
+                     "grid \"density\": is a level set (signed distances to a surface, not densities); convert it "
+                     "to a fog volume first");
+  openvdb::tools::sdfToFogVolume(*sphere);
+  write_grids(dir / "fog.vdb", {sphere});
+  const Volume fog = load_vdb_volume(dir / "fog.vdb", "density");
+  EXPECT_GT(fog.voxel_count(), 27000u);  // the ball of radius 15 voxels
+  EXPECT_EQ(*std::max_element(fog.values.begin(), fog.values.end()), 1.0f);
+}
+
+// issue 21: damaged copies of a real file (data/scenes/cloud.vdb, written by prizma-make-cloud-vdb)
+// were "out of memory" (std::bad_alloc: exit 1) when a damaged size asked for terabytes. Cut short
+// anywhere, or with one byte changed in its leaf data, the file is an InputError naming it, or (a
+// change OpenVDB cannot see) it reads; never another exception.
+TEST(VdbVolume, DamagedFilesAreInputErrorsNotOutOfMemory) {
+#if defined(__SANITIZE_ADDRESS__) || defined(PRIZMA_TEST_ASAN)
+  // AddressSanitizer's allocator aborts on the damaged sizes (allocation-size-too-big) before
+  // OpenVDB can throw, and the module's address-space bound is off there (vdb_module.cpp).
+  GTEST_SKIP() << "not under AddressSanitizer";
+#endif
+  ScratchDir dir;
+  std::ifstream in(std::filesystem::path(PRIZMA_TEST_DATA_DIR) / "scenes" / "cloud.vdb", std::ios::binary);
+  const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(good.size(), 42125u);
+  int refused = 0, asked_too_much = 0;
+  auto load = [&](const std::string& bytes, const std::string& what) {
+    const auto path = dir.write("damaged.vdb", bytes);
+    try {
+      load_vdb_volume(path, "density");
+    } catch (const InputError& e) {
+      ++refused;
+      const std::string m = e.what();
+      EXPECT_NE(m.find(path.string()), std::string::npos) << what << ": " << m;
+      asked_too_much += m.find("a size in it asks for more memory than any valid file of") != std::string::npos;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << what << ": " << typeid(e).name() << ": " << e.what();
+    }
+  };
+  for (int k = 1; k < 16; ++k) load(good.substr(0, good.size() * k / 16), "cut at " + std::to_string(k) + "/16");
+  for (std::size_t at = 700; at < 1500; at += 3) {
+    std::string bytes = good;
+    bytes[at] = static_cast<char>(bytes[at] ^ 0x5a);
+    load(bytes, "byte " + std::to_string(at));
+  }
+  EXPECT_GE(refused, 15 + 100);
+  EXPECT_GE(asked_too_much, 20);  // std::bad_alloc before
+}
+
+// issue 21: a grid 1.5·10⁹ voxels from the origin (one changed byte of cloud.vdb put it there) crashed
+// the dense copy: OpenVDB's parallel copyToDense splits the box at (min + max) / 2 in 32 bits. It reads
+// exactly as the same grid near the origin.
+TEST(VdbVolume, GridFarFromTheOriginReadsLikeNearIt) {
+  ScratchDir dir;
+  const openvdb::FloatGrid::Ptr near = sphere_grid(0.05);
+  auto far = openvdb::FloatGrid::create(0.0f);
+  far->setName("density");
+  far->setTransform(near->transform().copy());
+  const openvdb::Coord shift(0, 1509949440, -1200000000);
+  auto acc = far->getAccessor();
+  for (auto it = near->cbeginValueOn(); it; ++it) acc.setValue(it.getCoord() + shift, *it);
+  write_grids(dir / "near.vdb", {near});
+  write_grids(dir / "far.vdb", {far});
+  const Volume a = load_vdb_volume(dir / "near.vdb", "density");
+  const Volume b = load_vdb_volume(dir / "far.vdb", "density");
+  EXPECT_EQ(a.dims, b.dims);
+  EXPECT_EQ(a.values, b.values);
+  EXPECT_EQ(a.block_range, b.block_range);
 }
 
 TEST(VdbVolume, SceneFieldsAreChecked) {

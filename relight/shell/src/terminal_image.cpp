@@ -147,7 +147,7 @@ ImageProtocol detect_image_protocol(int in_fd, int out_fd) {
   if (!::isatty(out_fd)) return ImageProtocol::Blocks;
   const TerminalEnvironment env = TerminalEnvironment::from_process();
   if (auto p = image_protocol_from_environment(env)) return *p;
-  return query_image_protocol(in_fd, out_fd, 300, env.tmux.empty());
+  return query_image_protocol(in_fd, out_fd, kTerminalReplyTimeoutMs, env.tmux.empty());
 }
 
 Rgb8Image resample_rgb8(const std::vector<float>& rgb, int width, int height, int to_width, int to_height) {

@@ -49,7 +49,7 @@ struct PictureSpec {
   std::vector<std::string> channel_names;                       // empty: OpenImageIO's default (R, G, B, …)
   std::vector<std::pair<std::string, std::string>> attributes;  // string metadata, e.g. {"compression", "zip"}
   std::vector<std::pair<std::string, std::vector<float>>> float_attributes;  // e.g. {"chromaticities", 8 floats}
-  std::optional<PictureColourSpace> colour_space;  // PNG, TIFF, JPEG: embedded as an ICC profile
+  std::optional<PictureColourSpace> colour_space;  // PNG, TIFF, JPEG: embedded as an ICC profile (other formats have no place for one)
 };
 
 // Writes one picture into `out` (write_atomically's checked temporary), the format chosen by

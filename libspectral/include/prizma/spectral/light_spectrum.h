@@ -13,6 +13,12 @@
 
 namespace prizma::spectral {
 
+// The largest light scale (the product of a spec's trailing factors). Relighting multiplies it by the
+// exposure (at most 2^64 ≈ 1.8e19) and the colour matching weights in float: below 1e12 the weights stay
+// under 4e31, 10^7 short of float's largest, so a transport value up to that still gives a finite
+// colour. "D65*1e39" gave weights of +inf, NaN pixels and a black image with exit 0.
+constexpr double kMaxLightScale = 1e12;
+
 struct LightSpectrum {
   std::string text = "D65";  // the spec as given, echoed into output metadata
   Spectrum spectrum;         // the spectrum without the trailing scale
@@ -21,7 +27,8 @@ struct LightSpectrum {
 };
 
 // Parses "off", or any parse_spectrum spec with optional trailing "*<factor>" scales. Throws
-// InputError naming ctx.input for bad specs or negative / non-finite scales.
+// InputError naming ctx.input for bad specs, negative / non-finite scales, or a scale (the factors'
+// product) above kMaxLightScale.
 LightSpectrum parse_light_spectrum(std::string_view text, const SpecContext& ctx = {});
 
 // relight_weights() of the bare spectrum times the scale; a zero matrix for a light that is off.

@@ -156,6 +156,7 @@ struct Scene {
   std::string hash;              // hash of the scene file text and the volume bytes
   std::filesystem::path source;  // the scene file
   std::string volume_note;       // for the render's log: the volume's orientation, if any (Volume::orientation)
+  std::vector<std::string> warnings;  // problems noticed in inputs that were still read (Volume::warnings)
 };
 
 // A command-line override of one scene field (prizma-render -D KEY=VALUE).

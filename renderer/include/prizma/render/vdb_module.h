@@ -10,13 +10,15 @@
 
 extern "C" {
 
-#define PRIZMA_VDB_ABI_VERSION 1
+#define PRIZMA_VDB_ABI_VERSION 2  // 2: PrizmaVdbGridInfo::warnings
 #define PRIZMA_VDB_ENTRY_POINT "prizma_vdb_module_v1"
 
 enum PrizmaVdbStatus {
   PRIZMA_VDB_OK = 0,
-  PRIZMA_VDB_BAD_FILE = 1,       // the file: not readable as OpenVDB, or no grid of that name (input error)
-  PRIZMA_VDB_BAD_GRID = 2,       // the grid: not float, empty, a transform that is not axis-aligned (input error)
+  PRIZMA_VDB_BAD_FILE = 1,       // the file: not readable as OpenVDB (damaged, truncated, sizes no valid
+                                 // file of its length holds), or no grid of that name (input error)
+  PRIZMA_VDB_BAD_GRID = 2,       // the grid: not float, a level set, empty, a transform that is not
+                                 // axis-aligned (input error)
   PRIZMA_VDB_OUT_OF_MEMORY = 3,  // an allocation failed
   PRIZMA_VDB_FAILED = 4          // anything else (run-time failure)
 };
@@ -26,6 +28,9 @@ typedef struct PrizmaVdbGrid PrizmaVdbGrid;  // a float grid read into memory
 struct PrizmaVdbGridInfo {
   int dims[3];           // voxels of the active bounding box (index space), x, y, z
   double voxel_size[3];  // from the grid's linear transform, > 0 and finite
+  // What OpenVDB logged while it read the file (it still read it: e.g. an unknown format version),
+  // one message per line without colours, NUL-terminated; empty when it logged nothing.
+  char warnings[1024];
 };
 
 struct PrizmaVdbModule {

@@ -22,6 +22,9 @@ struct Volume {
   std::vector<std::array<float, 2>> block_range;
   // Human-readable notes for the render's log (e.g. the NIfTI orientation applied); may be empty.
   std::string orientation;
+  // What the file's library noticed in a file it still read ("cloud.vdb: OpenVDB: unsupported VDB file
+  // format (…)"), one line each: the tools print them as warnings.
+  std::vector<std::string> warnings;
 
   std::size_t voxel_count() const { return static_cast<std::size_t>(dims[0]) * dims[1] * dims[2]; }
   float at(int x, int y, int z) const {

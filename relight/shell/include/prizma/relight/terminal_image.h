@@ -36,10 +36,17 @@ struct TerminalEnvironment {
 std::optional<ImageProtocol> image_protocol_from_environment(const TerminalEnvironment& env);
 // What a terminal's replies to the kitty graphics query and to DA1 ("\x1b[?62;4;22c": 4 = sixel) say.
 ImageProtocol image_protocol_from_replies(std::string_view replies);
+// How long the query waits for the terminal's replies. Every terminal answers DSR, in milliseconds
+// when it is not busy; on a loaded machine tmux took over 300 ms (the bound until issue 21), and a
+// reply that comes after the query has given up is read by the line editor as typed keys
+// ("1;2cquit: unknown command"). So the query waits for the DSR reply itself; only a pseudo-terminal
+// whose other end answers nothing (a script) costs the whole bound, once per session.
+constexpr int kTerminalReplyTimeoutMs = 5000;
 // Sends the kitty graphics query (when ask_kitty), DA1 and DSR to out_fd and reads the replies from
 // in_fd (raw mode, restored after) until the DSR reply, at most timeout_ms. Blocks when either is not
 // a terminal or nothing answers in time: it never waits longer.
-ImageProtocol query_image_protocol(int in_fd, int out_fd, int timeout_ms = 300, bool ask_kitty = true);
+ImageProtocol query_image_protocol(int in_fd, int out_fd, int timeout_ms = kTerminalReplyTimeoutMs,
+                                   bool ask_kitty = true);
 // Environment first, then the query (only when both fds are terminals; inside tmux without the kitty
 // query, which tmux would take for a window title).
 ImageProtocol detect_image_protocol(int in_fd, int out_fd);
