@@ -1,0 +1,73 @@
+#pragma once
+// The denoiser's inner loops (kernel_simd.cpp), compiled for every x86 SIMD level with Highway and
+// chosen at run time. They use only IEEE-exact per-lane operations (add, multiply, divide, min,
+// max, rounding, bit operations; never a fused multiply-add), so every level, and every position of
+// a pixel in its tile, gives the same bits.
+#include <cstddef>
+#include <string>
+
+namespace prizma::denoise::detail {
+
+// Rows are padded to a multiple of this many floats (the widest vector, AVX-512), so the loops
+// only ever run over whole vectors.
+inline constexpr int kPadFloats = 16;
+inline int padded(int n) { return (n + kPadFloats - 1) / kPadFloats * kPadFloats; }
+
+// One feature plane of a tile: value and variance on the tile grown by r on every side (clamped
+// to the image), `stride` floats per row; `denominator` per tile pixel (row stride tile_wp).
+struct TileFeature {
+  const float* value;
+  const float* variance;
+  const float* denominator;  // k_f²·max(τ, V_p, |∇f_p|²)
+};
+
+// One neighbour offset (dx, dy) of a tile: its unnormalised weights w = exp(−max(e_colour,
+// e_feature)) for every tile pixel, e_colour = max(0, mean over the patch of d²) + max(0, z² − t²),
+// e_feature = max over features of max(0, d_f²) (docs/denoise.md). Exponents above kCutExponent give 0.
+struct OffsetJob {
+  // Tile size and padded width (a multiple of kPadFloats).
+  int tile_w = 0, tile_h = 0, tile_wp = 0;
+  int window_radius = 0, patch_radius = 0;
+  int dx = 0, dy = 0;
+  // Luminance and its variance on the tile grown by r + f (clamped), `lum_stride` floats per row.
+  const float* lum = nullptr;
+  const float* lum_var = nullptr;
+  int lum_stride = 0;
+  float eps = 0.0f;          // ε of the distances
+  float patch_k2 = 0.0f;     // k²
+  float centre_t2 = 0.0f;    // t² of the centre test (standard errors squared), 0 = none
+  float inv_patch_area = 0.0f;
+  const TileFeature* features = nullptr;
+  int feature_count = 0;
+  int feature_stride = 0;
+  // Scratch of at least (tile_h + 2f)·region_wp floats each, region_wp = padded(tile_wp + 2f).
+  float* d2 = nullptr;
+  float* hsum = nullptr;
+  // Output: tile_h rows of tile_wp weights.
+  float* weights = nullptr;
+};
+inline constexpr float kCutExponent = 20.0f;  // e^-20 = 2e-9 of the centre pixel's weight
+
+void offset_weights(const OffsetJob& job);
+
+// Divides each of `count` pixels' weights by their sum over the `kernel_size` offsets (offset-major,
+// plane stride `count`, a multiple of kPadFloats), summed in offset order.
+void normalise_kernels(float* kernels, int kernel_size, int count);
+
+// A plane the kernels are applied to: `channels` floats per pixel, pixel-major, whole image.
+struct ApplyPlane {
+  const float* in = nullptr;
+  float* out = nullptr;
+  int channels = 0;
+  bool squared = false;  // Σ W²·in (variance) instead of Σ W·in
+};
+
+// out(p) = Σ_taps w·in(p + delta) for one pixel p and every plane: `taps` neighbours with their pixel
+// index offset and weight (zero weights left out by the caller), in offset order.
+void apply_pixel(const ApplyPlane* planes, int plane_count, std::ptrdiff_t pixel, const std::ptrdiff_t* delta,
+                 const float* weight, const float* weight_squared, int taps);
+
+// The SIMD level in use ("AVX3", "AVX2", …).
+std::string simd_target();
+
+}  // namespace prizma::denoise::detail
