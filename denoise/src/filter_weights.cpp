@@ -41,7 +41,7 @@ void check_options(const DenoiseOptions& o) {
   };
   range("window radius", o.window_radius_px, 1, 15);
   range("patch radius", o.patch_radius_px, 0, 7);
-  range("tile size", o.tile_size_px, 8, 256);
+  range("tile size", o.tile_size_px, 8, 64);
   auto positive = [&](const char* name, float v, bool zero_allowed) {
     if (!std::isfinite(v) || v < 0.0f || (!zero_allowed && v == 0.0f))
       throw spectral::InputError(input, std::string(name) + " " + std::to_string(v) + " must be " +

@@ -30,7 +30,8 @@ struct DenoiseOptions {
   // τ of the feature distance as a fraction of the square of the feature's range over the image, > 0.
   float feature_tau = 1e-4f;
   VarianceOutput variance = VarianceOutput::Propagate;
-  // Side of the square tiles the weights are computed and applied in, 8–256 pixels; the result
+  // Side of the square tiles the weights are computed and applied in, 8–64 pixels (a tile's kernels
+  // take 4·(2r+1)²·side² bytes per thread: 0.5 MB by default, 16 MB at r = 15 and 64); the result
   // does not depend on it (nor on the thread count).
   int tile_size_px = 32;
 };
