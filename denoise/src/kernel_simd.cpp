@@ -37,13 +37,13 @@ HWY_INLINE V ExpNegative(D d, V x) {
   return hn::IfThenElseZero(hn::Lt(x, hn::Set(d, kCutExponent)), result);
 }
 
-// ((a − b)² − (va + min(va, vb))) / (eps + k2·(va + vb)): Rousselle et al. 2012's variance-cancelled
-// distance (the min keeps a noisy neighbour from cancelling more than the centre's own variance).
-HWY_INLINE V Distance(D d, V a, V b, V va, V vb, V eps, V k2) {
+// ((a − b)² − (va + min(va, vb))) / (eps + va + vb): Rousselle et al. 2012's variance-cancelled
+// distance with k = 1 (the min keeps a noisy neighbour from cancelling more than the centre's own
+// variance); the patch mean is divided by k² afterwards, so candidates of k share it.
+HWY_INLINE V Distance(V a, V b, V va, V vb, V eps) {
   const V diff = hn::Sub(a, b);
   const V num = hn::Sub(hn::Mul(diff, diff), hn::Add(va, hn::Min(va, vb)));
-  (void)d;
-  return hn::Div(num, hn::Add(eps, hn::Mul(k2, hn::Add(va, vb))));
+  return hn::Div(num, hn::Add(eps, hn::Add(va, vb)));
 }
 
 void OffsetWeights(const OffsetJob& j) {
@@ -52,7 +52,7 @@ void OffsetWeights(const OffsetJob& j) {
   const int f = j.patch_radius, r = j.window_radius;
   const int region_h = j.tile_h + 2 * f;
   const int region_wp = padded(j.tile_wp + 2 * f);
-  const V eps = hn::Set(d, j.eps), k2 = hn::Set(d, j.patch_k2), zero = hn::Zero(d);
+  const V eps = hn::Set(d, j.eps), zero = hn::Zero(d);
   // Per-pixel distances over the tile grown by f (the patches' pixels).
   for (int y = 0; y < region_h; ++y) {
     const float* a = j.lum + static_cast<std::ptrdiff_t>(y + r) * j.lum_stride + r;
@@ -61,7 +61,7 @@ void OffsetWeights(const OffsetJob& j) {
     const float* vb = j.lum_var + static_cast<std::ptrdiff_t>(y + r + j.dy) * j.lum_stride + r + j.dx;
     float* out = j.d2 + static_cast<std::ptrdiff_t>(y) * region_wp;
     for (int x = 0; x < region_wp; x += lanes)
-      hn::StoreU(Distance(d, hn::LoadU(d, a + x), hn::LoadU(d, b + x), hn::LoadU(d, va + x), hn::LoadU(d, vb + x), eps, k2),
+      hn::StoreU(Distance(hn::LoadU(d, a + x), hn::LoadU(d, b + x), hn::LoadU(d, va + x), hn::LoadU(d, vb + x), eps),
                 d, out + x);
   }
   // Patch sums: horizontal then vertical, each a fixed-order sum of 2f + 1 terms.
@@ -82,13 +82,15 @@ void OffsetWeights(const OffsetJob& j) {
       V patch = hn::LoadU(d, j.hsum + static_cast<std::ptrdiff_t>(y) * j.tile_wp + x);
       for (int t = 1; t <= 2 * f; ++t)
         patch = hn::Add(patch, hn::LoadU(d, j.hsum + static_cast<std::ptrdiff_t>(y + t) * j.tile_wp + x));
-      V e = hn::Max(zero, hn::Mul(patch, inv_area));
+      const V mean_d2 = hn::Mul(patch, inv_area);
+      const std::ptrdiff_t t = static_cast<std::ptrdiff_t>(y) * j.tile_wp + x;
+      // What the candidates share: the centre test and the features.
+      V shared = zero, feature = zero;
       if (j.centre_t2 > 0.0f) {
         // z² − t², z the centres' difference in standard errors: 0 below t, steep above it.
         const V diff = hn::Sub(hn::LoadU(d, j.lum + centre_row + x), hn::LoadU(d, j.lum + neighbour_row + x));
         const V v = hn::Add(hn::LoadU(d, j.lum_var + centre_row + x), hn::LoadU(d, j.lum_var + neighbour_row + x));
-        const V dc = hn::Div(hn::Sub(hn::Mul(diff, diff), hn::Mul(ct2, v)), hn::Add(eps, v));
-        e = hn::Add(e, hn::Max(zero, dc));
+        shared = hn::Max(zero, hn::Div(hn::Sub(hn::Mul(diff, diff), hn::Mul(ct2, v)), hn::Add(eps, v)));
       }
       for (int k = 0; k < j.feature_count; ++k) {
         const TileFeature& ft = j.features[k];
@@ -97,10 +99,12 @@ void OffsetWeights(const OffsetJob& j) {
         const V diff = hn::Sub(hn::LoadU(d, ft.value + c), hn::LoadU(d, ft.value + q));
         const V vp = hn::LoadU(d, ft.variance + c), vq = hn::LoadU(d, ft.variance + q);
         const V num = hn::Sub(hn::Mul(diff, diff), hn::Add(vp, hn::Min(vp, vq)));
-        const V df = hn::Div(num, hn::LoadU(d, ft.denominator + static_cast<std::ptrdiff_t>(y) * j.tile_wp + x));
-        e = hn::Max(e, df);
+        feature = hn::Max(feature, hn::Div(num, hn::LoadU(d, ft.denominator + t)));
       }
-      hn::StoreU(ExpNegative(d, e), d, j.weights + static_cast<std::ptrdiff_t>(y) * j.tile_wp + x);
+      for (int c = 0; c < j.candidates; ++c) {
+        const V colour = hn::Add(hn::Max(zero, hn::Mul(mean_d2, hn::LoadU(d, j.inv_k2[c] + t))), shared);
+        hn::StoreU(ExpNegative(d, hn::Max(colour, feature)), d, j.weights[c] + t);
+      }
     }
   }
 }
@@ -115,6 +119,19 @@ void NormaliseKernels(float* kernels, int kernel_size, int count) {
       float* w = kernels + static_cast<std::ptrdiff_t>(o) * count + x;
       hn::StoreU(hn::Div(hn::LoadU(d, w), sum), d, w);
     }
+  }
+}
+
+void MultiplyAddRows(const float* w, int w_stride, const float* v, int v_stride, float* acc, int acc_stride, int rows,
+                     int width) {
+  const D d;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  for (int y = 0; y < rows; ++y) {
+    const float* wr = w + static_cast<std::ptrdiff_t>(y) * w_stride;
+    const float* vr = v + static_cast<std::ptrdiff_t>(y) * v_stride;
+    float* ar = acc + static_cast<std::ptrdiff_t>(y) * acc_stride;
+    for (int x = 0; x < width; x += lanes)
+      hn::StoreU(hn::Add(hn::LoadU(d, ar + x), hn::Mul(hn::LoadU(d, wr + x), hn::LoadU(d, vr + x))), d, ar + x);
   }
 }
 
@@ -153,6 +170,7 @@ namespace prizma::denoise::detail {
 HWY_EXPORT(OffsetWeights);
 HWY_EXPORT(NormaliseKernels);
 HWY_EXPORT(ApplyPixel);
+HWY_EXPORT(MultiplyAddRows);
 
 void offset_weights(const OffsetJob& job) { HWY_DYNAMIC_DISPATCH(OffsetWeights)(job); }
 
@@ -163,6 +181,11 @@ void normalise_kernels(float* kernels, int kernel_size, int count) {
 void apply_pixel(const ApplyPlane* planes, int plane_count, std::ptrdiff_t pixel, const std::ptrdiff_t* delta,
                  const float* weight, const float* weight_squared, int taps) {
   HWY_DYNAMIC_DISPATCH(ApplyPixel)(planes, plane_count, pixel, delta, weight, weight_squared, taps);
+}
+
+void multiply_add_rows(const float* w, int w_stride, const float* v, int v_stride, float* acc, int acc_stride, int rows,
+                       int width) {
+  HWY_DYNAMIC_DISPATCH(MultiplyAddRows)(w, w_stride, v, v_stride, acc, acc_stride, rows, width);
 }
 
 std::string simd_target() {

@@ -19,6 +19,11 @@ struct DenoiseOptions {
   // k of the patch distance d² = ((u_p − u_q)² − (V_p + min(V_p, V_q))) / (ε + k²(V_p + V_q)), > 0:
   // larger averages more (and blurs more).
   float patch_k = 0.45f;
+  // A second k, ≥ 0 (0: none): each pixel's kernel then uses whichever of patch_k and patch_k_wide
+  // gives the smaller SURE estimate of the filtered luminance's error, averaged over the
+  // (2s+1)² pixels around it, s = sure_radius_px in [0, 15] (docs/denoise.md, "The weights").
+  float patch_k_wide = 1.0f;
+  int sure_radius_px = 3;
   // The centre test: a neighbour whose value differs from the pixel's by z > t standard errors
   // (z² = (u_p − u_q)² / (V_p + V_q)) gets its weight multiplied by e^−(z² − t²), so a pixel keeps
   // out neighbours that disagree beyond their noise even when their patches match (thin structures,

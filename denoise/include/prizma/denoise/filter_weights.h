@@ -44,7 +44,7 @@ class FilterWeights {
   void tile_kernels(const PixelRect& rect, std::vector<float>& out) const;
 
  private:
-  friend FilterWeights compute_weights(const DenoiseGuides&, const DenoiseOptions&);
+  friend FilterWeights compute_weights(DenoiseGuides&&, const DenoiseOptions&);
   struct Derived;
   int m_width = 0;
   int m_height = 0;
@@ -54,8 +54,11 @@ class FilterWeights {
 };
 
 // Validates the guides (check_guides) and the options (InputError, input "denoise options", naming
-// the option and its range) and returns the weights they define. Cheap: the kernels are computed
-// when applied. Depends only on its arguments, never on a light.
+// the option and its range) and returns the weights they define. The kernels themselves are
+// computed when applied; with patch_k_wide, each pixel's choice between the two k is made here (one
+// pass of kernels over the image, on the luminance). Depends only on its arguments, never on a light.
 FilterWeights compute_weights(const DenoiseGuides& guides, const DenoiseOptions& options = {});
+// The same, keeping `guides` without a copy.
+FilterWeights compute_weights(DenoiseGuides&& guides, const DenoiseOptions& options = {});
 
 }  // namespace prizma::denoise
