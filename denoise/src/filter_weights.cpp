@@ -1,5 +1,6 @@
 // The kernels of a tile: the guides gathered around the tile (borders replicated), then, for each
-// neighbour offset, the patch and feature distances and their weights (kernel_simd.cpp), normalised.
+// neighbour offset, the patch and feature distances and their weights (kernel_simd.cpp), normalised;
+// and the per-pixel choice of k by SURE that compute_weights makes once (docs/denoise.md).
 #include "prizma/denoise/filter_weights.h"
 
 #include <algorithm>

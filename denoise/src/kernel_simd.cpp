@@ -188,10 +188,5 @@ void multiply_add_rows(const float* w, int w_stride, const float* v, int v_strid
   HWY_DYNAMIC_DISPATCH(MultiplyAddRows)(w, w_stride, v, v_stride, acc, acc_stride, rows, width);
 }
 
-std::string simd_target() {
-  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
-  return targets.empty() ? std::string("none") : std::string(hwy::TargetName(targets.front()));
-}
-
 }  // namespace prizma::denoise::detail
 #endif

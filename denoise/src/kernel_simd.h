@@ -4,7 +4,6 @@
 // max, rounding, bit operations; never a fused multiply-add), so every level, and every position of
 // a pixel in its tile, gives the same bits.
 #include <cstddef>
-#include <string>
 
 namespace prizma::denoise::detail {
 
@@ -77,8 +76,5 @@ struct ApplyPlane {
 // index offset and weight (zero weights left out by the caller), in offset order.
 void apply_pixel(const ApplyPlane* planes, int plane_count, std::ptrdiff_t pixel, const std::ptrdiff_t* delta,
                  const float* weight, const float* weight_squared, int taps);
-
-// The SIMD level in use ("AVX3", "AVX2", …).
-std::string simd_target();
 
 }  // namespace prizma::denoise::detail
