@@ -1,6 +1,8 @@
 // The luminance guide from a spectral image's transport and variance layers, and the guides' checks.
 #include "prizma/denoise/denoise_guides.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -70,7 +72,8 @@ DenoiseGuides luminance_guides(const spectral::SpectralImage& image) {
   g.luminance.name = "luminance";
   g.luminance.value.resize(pixels);
   g.luminance.variance.resize(pixels);
-  for (std::size_t p = 0; p < pixels; ++p) {
+  // Parallel over pixels, each written once: the thread count changes no bit.
+  tbb::parallel_for(std::size_t{0}, pixels, [&](std::size_t p) {
     double y = 0.0, sigma = 0.0;
     for (const spectral::TransportLayer& layer : image.lights) {
       const float* t = layer.data.data() + p * nb;
@@ -84,7 +87,7 @@ DenoiseGuides luminance_guides(const spectral::SpectralImage& image) {
     }
     g.luminance.value[p] = static_cast<float>(y);
     g.luminance.variance[p] = static_cast<float>(sigma * sigma);
-  }
+  });
   check_guides(g);
   return g;
 }

@@ -1,6 +1,7 @@
 // denoise() of a whole spectral image and the luminance guide it is computed from: the guide's
 // closed form, the variance layers it writes, and what it refuses.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -85,6 +86,21 @@ TEST(DenoiseImage, VarianceLayersHoldTheFilteredValuesVariance) {
         EXPECT_LT(got, img.lights[l].variance[(static_cast<std::size_t>(y) * 40 + x) * nb + i]);
       }
   }
+}
+
+TEST(DenoiseImage, TheSameBitsWhateverTheThreadCount) {
+  // The whole path (luminance guide, SURE choice, kernels, every plane) on 1, 2 and 3 threads.
+  const auto img = ramp_image();
+  std::vector<spectral::SpectralImage> out;
+  for (int threads : {1, 2, 3}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    out.push_back(denoise(img));
+  }
+  for (std::size_t k = 1; k < out.size(); ++k)
+    for (std::size_t l = 0; l < img.lights.size(); ++l) {
+      EXPECT_EQ(out[k].lights[l].data, out[0].lights[l].data) << "run " << k << " light " << l;
+      EXPECT_EQ(out[k].lights[l].variance, out[0].lights[l].variance) << "run " << k << " light " << l;
+    }
 }
 
 TEST(DenoiseImage, DropsTheVarianceLayersWhenAsked) {
