@@ -8,7 +8,7 @@
 //   bench_denoise_error [--scenes cube_sphere,mri_head,cloud_vdb,bench_peer] [--size 256]
 //       [--spp 16,64,256] [--bias-spp 4096] [--ref-spp 16384] [--threads 2]
 //       [--lights D65,F11,gaussian:450:10] [--cache build-bench/cache] [--out FILE.csv]
-//       [--images DIR] [--guides luminance]
+//       [--images DIR] [--guides luminance] [--references-only]
 //
 // relMSE = mean over pixels and X, Y, Z of (x − r)² / (r² + ε), ε = 0.01 (Rousselle et al. 2011,
 // Bitterli et al. 2016; white has Y = 1). The reference's own noise adds E[(r − E r)²/(r² + ε)] to
@@ -50,6 +50,7 @@ struct Options {
   std::string images;
   std::string guides = "luminance";
   std::uint64_t seed = 1;
+  bool references_only = false;
 };
 
 // The guides the weights are computed from. "luminance": the white luminance of the transport (all
@@ -125,7 +126,7 @@ void measure_scene(const std::string& name, const Options& o, std::ostringstream
   for (std::size_t k = 0; k < o.lights.size(); ++k) ref_xyz.push_back(pb::relight_all(ref, o.lights[k], &white[k]));
   save(o, name + "-ref", ref);
 
-  std::vector<std::int64_t> counts = o.spp;
+  std::vector<std::int64_t> counts = o.references_only ? std::vector<std::int64_t>{} : o.spp;
   if (o.bias_spp > 0) counts.push_back(o.bias_spp);
   for (const std::int64_t n : counts) {
     const bool bias_run = o.bias_spp > 0 && n == o.bias_spp;
@@ -178,6 +179,7 @@ int main(int argc, char** argv) {
   app.add_option("--images", o.images, "folder to write the raw, denoised and reference EXR files into");
   app.add_option("--guides", o.guides, "guides of the weights: luminance");
   app.add_option("--seed", o.seed, "seed of the measured renders (the reference uses seed + 1000003)");
+  app.add_flag("--references-only", o.references_only, "only render (and cache) the references and bias renders");
   CLI11_PARSE(app, argc, argv);
   std::ostringstream csv;
   csv << "scene,spp,light,raw_seconds,denoise_seconds,relmse_raw,relmse_denoised,reference_floor,"
