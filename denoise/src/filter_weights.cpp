@@ -224,11 +224,12 @@ std::vector<float> box_mean(const std::vector<float>& plane, int w, int h, int s
   return out;
 }
 
-// The per-pixel choice between k and k_wide (Rousselle et al. 2012's SURE-based selection, on the
-// luminance): for each candidate c, Stein's unbiased estimate of the squared error of the filtered
-// luminance, SURE_c(p) = (ŷ_c(p) − y(p))² − V(p) + 2·V(p)·W_c(p, p), treating the weights as fixed;
-// averaged over a (2s+1)² box (one pixel's estimate is too noisy to choose on); the smaller wins,
-// k on ties. A function of the guides only, so the chosen kernels are as light-independent as k.
+// The per-pixel choice between k and k_wide (SURE-based filter selection: Li, Wu, Chuang 2012;
+// Rousselle et al. 2013), made on the luminance: for each candidate c, Stein's unbiased estimate of
+// the squared error of the filtered luminance, SURE_c(p) = (ŷ_c(p) − y(p))² − V(p) + 2·V(p)·W_c(p, p),
+// treating the weights as fixed; averaged over a (2s+1)² box (one pixel's estimate is too noisy to
+// choose on); the smaller wins, k on ties. A function of the guides only, so the chosen kernels
+// are as light-independent as k.
 std::vector<float> choose_inv_k2(const WeightsContext& cx) {
   const DenoiseGuides& g = cx.guides;
   const int w = g.width, h = g.height, tile = cx.options.tile_size_px;

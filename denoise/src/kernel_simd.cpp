@@ -8,6 +8,7 @@
 #include <hwy/highway.h>
 
 #include "kernel_simd.h"
+#include "prizma/denoise/simd_target.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace prizma::denoise::detail::HWY_NAMESPACE {
@@ -186,6 +187,24 @@ void apply_pixel(const ApplyPlane* planes, int plane_count, std::ptrdiff_t pixel
 void multiply_add_rows(const float* w, int w_stride, const float* v, int v_stride, float* acc, int acc_stride, int rows,
                        int width) {
   HWY_DYNAMIC_DISPATCH(MultiplyAddRows)(w, w_stride, v, v_stride, acc, acc_stride, rows, width);
+}
+
+std::vector<std::string> simd_targets() {
+  std::vector<std::string> names;
+  for (const std::int64_t t : hwy::SupportedAndGeneratedTargets()) names.emplace_back(hwy::TargetName(t));
+  return names;
+}
+
+void force_simd_target(const std::string& name) {
+  if (name.empty()) {
+    hwy::SetSupportedTargetsForTest(0);
+    return;
+  }
+  for (const std::int64_t t : hwy::SupportedAndGeneratedTargets())
+    if (name == hwy::TargetName(t)) {
+      hwy::SetSupportedTargetsForTest(t);
+      return;
+    }
 }
 
 }  // namespace prizma::denoise::detail

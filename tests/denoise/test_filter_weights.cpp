@@ -7,11 +7,13 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include "denoise_test_util.h"
 #include "prizma/denoise/denoise.h"
 #include "prizma/denoise/filter_weights.h"
+#include "prizma/denoise/simd_target.h"
 #include "prizma/spectral/error.h"
 
 namespace prizma::denoise {
@@ -185,6 +187,24 @@ TEST(FilterWeights, TheSameBitsWhateverTheThreadCountAndTileSize) {
       results.push_back(apply(compute_weights(g, o), values, 5));
     }
   for (std::size_t k = 1; k < results.size(); ++k) EXPECT_EQ(results[k], results[0]) << "run " << k;
+}
+
+TEST(FilterWeights, TheSameBitsOnEverySimdLevel) {
+  // The inner loops use only IEEE per-lane operations (no fused multiply-add, an exponential of
+  // their own): every level this CPU runs must give the baseline's bits, SURE choice included.
+  const auto g = test::noisy_guides(kW, kH, 0.05f, 10, [](int x, int y) { return 1.0 + 0.3 * std::sin(0.2 * x + 0.1 * y); });
+  std::vector<float> values(g.luminance.value.size() * 7);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = static_cast<float>((i * 7919) % 1000) * 1e-3f;
+  const std::vector<std::string> targets = detail::simd_targets();
+  ASSERT_FALSE(targets.empty());
+  std::vector<float> baseline;
+  for (const std::string& t : targets) {
+    detail::force_simd_target(t);
+    const std::vector<float> out = apply(compute_weights(g), values, 7);
+    if (baseline.empty()) baseline = out;
+    EXPECT_EQ(out, baseline) << "SIMD level " << t << " (first: " << targets.front() << ")";
+  }
+  detail::force_simd_target("");
 }
 
 TEST(FilterWeights, OnePixelsKernelIsTheOneItsTileUses) {
