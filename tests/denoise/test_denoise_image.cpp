@@ -1,0 +1,142 @@
+// denoise() of a whole spectral image and the luminance guide it is computed from: the guide's
+// closed form, the variance layers it writes, and what it refuses.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "denoise_test_util.h"
+#include "prizma/denoise/denoise.h"
+#include "prizma/spectral/error.h"
+
+namespace prizma::denoise {
+namespace {
+
+TEST(LuminanceGuide, AWhiteUnderEachLightHasYOneAndTheCorrelatedVariance) {
+  // T = 1 in every bin of each of 2 lights: Y = 2 (a perfect white has Y = 1 per light). σ = s in
+  // every bin: the correlated bound is (Σ_l Σ_i ȳ_i·s)² = (2s)² since Σ_i ȳ_i = 1.
+  const float s = 0.03f;
+  const auto img = test::make_image(4, 3, spectral::BinLayout::linear(400, 700, 12), 2,
+                                    [](int, std::size_t, int) { return 1.0f; }, [&](int, std::size_t, int) { return s * s; });
+  const DenoiseGuides g = luminance_guides(img);
+  ASSERT_EQ(g.luminance.value.size(), 12u);
+  for (std::size_t p = 0; p < 12; ++p) {
+    EXPECT_NEAR(g.luminance.value[p], 2.0f, 1e-6f);
+    EXPECT_NEAR(g.luminance.variance[p], 4.0f * s * s, 1e-6f * s * s);
+  }
+}
+
+TEST(LuminanceGuide, WeighsBinsByTheLuminanceMatchingFunction) {
+  // One bin at a time set to 1: Y is ∫_{bin} ȳ / ∫_{400–700} ȳ, largest at the bin holding 555 nm.
+  const auto bins = spectral::BinLayout::linear(400, 700, 6);
+  std::vector<float> y;
+  for (int b = 0; b < 6; ++b) {
+    const auto img = test::make_image(1, 1, bins, 1, [&](int, std::size_t, int i) { return i == b ? 1.0f : 0.0f; },
+                                      [](int, std::size_t, int) { return 0.0f; });
+    y.push_back(luminance_guides(img).luminance.value[0]);
+  }
+  EXPECT_NEAR(y[0] + y[1] + y[2] + y[3] + y[4] + y[5], 1.0f, 1e-6f);
+  EXPECT_EQ(std::max_element(y.begin(), y.end()) - y.begin(), 3);  // 550–600 nm
+  EXPECT_LT(y[0], 0.01f);                                          // 400–450 nm
+}
+
+TEST(LuminanceGuide, RefusesAnImageWithoutVariance) {
+  auto img = test::make_image(4, 4, spectral::BinLayout(), 1, [](int, std::size_t, int) { return 1.0f; },
+                              [](int, std::size_t, int) { return 0.0f; });
+  img.lights[0].variance.clear();
+  try {
+    luminance_guides(img);
+    FAIL() << "accepted an image without variance";
+  } catch (const spectral::InputError& e) {
+    EXPECT_STREQ(e.what(), "image: light \"light0\" has no variance layer: the denoiser weighs neighbours by their "
+                           "noise (render with --variance)");
+  }
+}
+
+spectral::SpectralImage ramp_image() {
+  std::mt19937 rng(21);
+  std::normal_distribution<float> noise(0.0f, 0.02f);
+  return test::make_image(
+      40, 30, spectral::BinLayout::linear(400, 700, 8), 2,
+      [&](int l, std::size_t p, int i) { return 0.5f + 0.01f * static_cast<float>(p % 40 + i + l) + noise(rng); },
+      [](int, std::size_t p, int i) { return 4e-4f * (1.0f + 0.1f * static_cast<float>((p + i) % 5)); });
+}
+
+TEST(DenoiseImage, VarianceLayersHoldTheFilteredValuesVariance) {
+  // Propagate: Var(p) = Σ_q W(p,q)²·Var(q), checked in double from kernel() at a few pixels.
+  const auto img = ramp_image();
+  const FilterWeights w = compute_weights(luminance_guides(img));
+  const auto den = denoise(img, w);
+  const int r = w.window_radius_px(), n = 2 * r + 1, nb = img.bins.size();
+  for (auto [x, y] : {std::pair{0, 0}, {20, 15}, {39, 29}}) {
+    const std::vector<float> k = w.kernel(x, y);
+    for (int l = 0; l < 2; ++l)
+      for (int i = 0; i < nb; ++i) {
+        double var = 0.0;
+        for (int o = 0; o < n * n; ++o)
+          if (k[o] != 0.0f)
+            var += static_cast<double>(k[o]) * k[o] *
+                   img.lights[l].variance[(static_cast<std::size_t>(y + o / n - r) * 40 + (x + o % n - r)) * nb + i];
+        const float got = den.lights[l].variance[(static_cast<std::size_t>(y) * 40 + x) * nb + i];
+        EXPECT_NEAR(got, var, 1e-6 * var);
+        // A filter that averages anything reduces the variance; the raw variance is not kept.
+        EXPECT_LT(got, img.lights[l].variance[(static_cast<std::size_t>(y) * 40 + x) * nb + i]);
+      }
+  }
+}
+
+TEST(DenoiseImage, TheSameBitsWhateverTheThreadCount) {
+  // The whole path (luminance guide, SURE choice, kernels, every plane) on 1, 2 and 3 threads.
+  const auto img = ramp_image();
+  std::vector<spectral::SpectralImage> out;
+  for (int threads : {1, 2, 3}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    out.push_back(denoise(img));
+  }
+  for (std::size_t k = 1; k < out.size(); ++k)
+    for (std::size_t l = 0; l < img.lights.size(); ++l) {
+      EXPECT_EQ(out[k].lights[l].data, out[0].lights[l].data) << "run " << k << " light " << l;
+      EXPECT_EQ(out[k].lights[l].variance, out[0].lights[l].variance) << "run " << k << " light " << l;
+    }
+}
+
+TEST(DenoiseImage, DropsTheVarianceLayersWhenAsked) {
+  const auto img = ramp_image();
+  DenoiseOptions o;
+  o.variance = VarianceOutput::Drop;
+  const auto den = denoise(img, o);
+  for (const auto& layer : den.lights) {
+    EXPECT_TRUE(layer.variance.empty());
+    EXPECT_EQ(layer.data.size(), img.lights[0].data.size());
+  }
+}
+
+TEST(DenoiseImage, FiltersTheSpectralBasisCoefficientsWithTheSameKernels) {
+  // Coefficients are linear in the bins (c = Bᵀt): filtering them is filtering t. The errors
+  // measured on the raw values no longer describe them and are cleared.
+  auto img = ramp_image();
+  for (auto& layer : img.lights) {
+    layer.coefficients.k = 2;
+    layer.coefficients.basis.assign(2 * 8, 0.25f);
+    for (std::size_t p = 0; p < img.pixel_count(); ++p) {
+      layer.coefficients.values.push_back(layer.data[p * 8]);
+      layer.coefficients.values.push_back(layer.data[p * 8 + 3]);
+    }
+    layer.coefficients.errors.push_back({"D65", 0.1, 0.2});
+  }
+  const auto den = denoise(img);
+  for (const auto& layer : den.lights) {
+    EXPECT_EQ(layer.coefficients.k, 2);
+    EXPECT_TRUE(layer.coefficients.errors.empty());
+    for (std::size_t p = 0; p < img.pixel_count(); ++p) {
+      EXPECT_EQ(layer.coefficients.values[2 * p], layer.data[p * 8]) << p;
+      EXPECT_EQ(layer.coefficients.values[2 * p + 1], layer.data[p * 8 + 3]) << p;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace prizma::denoise
