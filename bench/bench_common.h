@@ -142,13 +142,14 @@ inline std::string hash_hex(const std::string& s) {
 
 // Renders (or reads from the cache folder) an image keyed on the scene hash and every setting that
 // changes the result.
+// folded: render::render_folded (a reference with the lights folded in), else render::render.
 inline spectral::SpectralImage cached_render(const render::Scene& scene, const fs::path& cache_dir,
-                                             const std::string& tag, double* seconds = nullptr) {
+                                             const std::string& tag, double* seconds = nullptr, bool folded = false) {
   const auto& st = scene.settings;
   std::ostringstream key;
   key << scene.hash << '|' << scene.camera.width << 'x' << scene.camera.height << '|' << st.bins.to_string() << '|'
       << st.sample_begin << ':' << st.sample_end << '|' << st.seed << '|'
-      << render::wavelength_sampling_name(st.wavelength_sampling) << '|' << st.fold_light_spectra << '|'
+      << render::wavelength_sampling_name(st.wavelength_sampling) << '|' << folded << '|'
       << st.write_variance << '|' << st.max_bounces << '|' << render::event_probabilities_name(st.event_probabilities);
   if (st.sampler != render::Sampler::Independent) key << '|' << render::sampler_name(st.sampler);  // older keys unchanged
   for (const auto& l : scene.lights) key << '|' << l.name << ':' << l.spectrum_spec;
@@ -162,7 +163,7 @@ inline spectral::SpectralImage cached_render(const render::Scene& scene, const f
     }
   }
   render::RenderStats stats;
-  spectral::SpectralImage img = render::render(scene, {}, &stats);
+  spectral::SpectralImage img = folded ? render::render_folded(scene, {}, &stats) : render::render(scene, {}, &stats);
   if (seconds) *seconds = stats.wall_seconds;
   fs::create_directories(cache_dir);
   spectral::write_spectral_exr(file, img);

@@ -1,6 +1,6 @@
 // bench_bin_study: how many bins does relighting need? For each light, relit images with n bins are
 // compared (CIEDE2000 per pixel) with a reference in which the light is folded into the rendering
-// (fold_light_spectra: each path's radiance multiplied by E(λ) at its own wavelength) over fine bins
+// (render::render_folded: each path's radiance multiplied by E(λ) at its own wavelength) over fine bins
 // (320 × 1.25 nm), converted to XYZ by integrating bins × CMF. The n-bin transport is the average of
 // the fine transport over each coarse bin (its exact expectation), from the same seed and so the same
 // paths as the reference: path noise cancels and the difference is the binning error. The noise of a
@@ -108,9 +108,8 @@ int main(int argc, char** argv) {
         // Reference: the same render with the light folded in (same seed, so the same paths: folding
         // multiplies each path's radiance by E(λ) after tracing and draws no random numbers).
         pr::Scene r = fine_scene;
-        r.settings.fold_light_spectra = true;
         for (auto& l : r.lights) l.spectrum_spec = light;
-        const auto ref = pb::cached_render(r, cache, "fold-" + name, &sec);
+        const auto ref = pb::cached_render(r, cache, "fold-" + name, &sec, /*folded=*/true);
         std::cerr << name << ": folded reference " << light << " " << (sec > 0 ? std::to_string(sec) + " s" : "cached")
                   << "\n";
         Eigen::Vector3d white;
@@ -136,7 +135,7 @@ int main(int argc, char** argv) {
         if (li == 0) {
           pr::Scene r2 = r;
           r2.settings.seed = 2;
-          const auto ref2 = pb::cached_render(r2, cache, "fold-" + name, &sec);
+          const auto ref2 = pb::cached_render(r2, cache, "fold-" + name, &sec, /*folded=*/true);
           row("noise_floor", fine_bins, pb::delta_e_stats(pb::folded_to_xyz(ref2, light), ref_xyz, white));
         }
       }

@@ -46,7 +46,7 @@ struct UnitLights {
   static constexpr bool kFolds = false;
   double at(int, double) const { return 1.0; }
 };
-// settings.fold_light_spectra (tests and benchmarks): each light's contribution at λ multiplied by
+// render_folded() (tests and benchmarks): each light's contribution at λ multiplied by
 // its default spectrum at λ (the light "baked in", as VPT does). A separate instantiation of the
 // sample loop, so the production loop has no branch for it.
 struct FoldedLights {
@@ -309,7 +309,12 @@ Sampler parse_sampler(std::string_view name, std::string_view input) {
   throw InputError(std::string(input), "unknown sampler \"" + std::string(name) + "\" (known: independent, sobol)");
 }
 
-spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callbacks, RenderStats* stats_out) {
+namespace {
+
+// render() and render_folded(): `fold` chooses the lights' treatment (the sample loop is instantiated
+// for each, so the production loop has no branch for the test mode).
+spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& callbacks, RenderStats* stats_out,
+                                     bool fold) {
   const auto start = std::chrono::steady_clock::now();
   const RenderSettings& st = scene.settings;
   const spectral::BinLayout& bins = st.bins;
@@ -352,7 +357,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
 
   // Test/benchmark mode: lights folded in with their default spectra.
   FoldedLights folded;
-  if (st.fold_light_spectra) {
+  if (fold) {
     spectral::SpecContext ctx;
     if (!scene.source.empty()) ctx.base_dir = scene.source.parent_path();
     for (int l = 0; l < nl; ++l) {
@@ -366,7 +371,7 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   layout.height = camera.height();
   layout.lights = nl;
   layout.bins = bins;
-  if (fluorescent && !st.fold_light_spectra) layout.bispectral = fluor.pairs;  // folded: all on the diagonal
+  if (fluorescent && !fold) layout.bispectral = fluor.pairs;  // folded: all on the diagonal
   layout.variance = st.write_variance;
   layout.target_error = st.target_error;
   Film film(std::move(layout));
@@ -389,8 +394,8 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
   const RenderContext context{st,   camera, tracer, map, fluor, source, fluorescent, std::move(pair_index),
                               film, callbacks.cancel, pass_cut};
   bool interrupted = false;
-  const std::int64_t done = st.fold_light_spectra ? run_passes(context, folded, states, callbacks, start, interrupted)
-                                                  : run_passes(context, UnitLights{}, states, callbacks, start, interrupted);
+  const std::int64_t done = fold ? run_passes(context, folded, states, callbacks, start, interrupted)
+                            : run_passes(context, UnitLights{}, states, callbacks, start, interrupted);
   if (done == 0) throw spectral::RuntimeError("render interrupted before the first pass completed");
 
   std::vector<std::string> names;
@@ -423,6 +428,16 @@ spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callba
     *stats_out = s;
   }
   return img;
+}
+
+}  // namespace
+
+spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callbacks, RenderStats* stats) {
+  return render_scene(scene, callbacks, stats, /*fold=*/false);
+}
+
+spectral::SpectralImage render_folded(const Scene& scene, const RenderCallbacks& callbacks, RenderStats* stats) {
+  return render_scene(scene, callbacks, stats, /*fold=*/true);
 }
 
 }  // namespace prizma::render

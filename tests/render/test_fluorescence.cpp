@@ -174,8 +174,7 @@ struct BispectralAndFolded {
 BispectralAndFolded expect_relit_equals_folded(Scene s) {
   BispectralAndFolded r;
   r.bispectral = render(s);
-  s.settings.fold_light_spectra = true;
-  r.folded = render(s);
+  r.folded = render_folded(s);
   const spectral::SpectralImage& bi = r.bispectral;
   EXPECT_FALSE(bi.reradiation.empty());
   EXPECT_TRUE(r.folded.reradiation.empty());

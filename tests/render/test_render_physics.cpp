@@ -93,8 +93,7 @@ TEST(RenderPhysics, FoldedLightEqualsRelitTransport) {
   s.lights[0].spectrum_spec = "box:500:600*0.5";
   s.lights[1].spectrum_spec = "box:500:600*0.5";
   const auto white = render(s);
-  s.settings.fold_light_spectra = true;
-  const auto folded = render(s);
+  const auto folded = render_folded(s);
   const double light[6] = {0, 0, 0.5, 0.5, 0, 0};
   double checked = 0;
   for (int l = 0; l < 2; ++l)

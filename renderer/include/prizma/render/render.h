@@ -53,6 +53,13 @@ struct RenderStats {
 // Throws InputError for settings it cannot render (empty bins, sample_end ≤ sample_begin, no lights).
 spectral::SpectralImage render(const Scene& scene, const RenderCallbacks& callbacks = {},
                                RenderStats* stats = nullptr);
+// For tests and benchmarks, never a file Prizma writes: the render with each light's default spectrum
+// multiplied into its radiance at the path's own wavelengths (the light "folded into the rendering",
+// as VPT does) instead of unit white; a fluorescent scene's re-radiated light lands on the diagonal.
+// The reference that relighting the stored transport is checked against. The same paths as render()
+// (folding draws no random numbers).
+spectral::SpectralImage render_folded(const Scene& scene, const RenderCallbacks& callbacks = {},
+                                      RenderStats* stats = nullptr);
 
 // Combines renders of disjoint sample ranges of the same scene into the render of their union
 // (weighted by sample counts; variance layers combined when all shards carry them). Throws

@@ -142,9 +142,6 @@ struct RenderSettings {
   bool use_majorant_grid = true;
   int threads = 0;                    // 0 = all cores
   bool write_variance = false;
-  // Test/benchmark mode: multiply each light's radiance by its default spectrum at the path's
-  // wavelengths (the light "folded into the rendering", as VPT does) instead of unit white.
-  bool fold_light_spectra = false;
 };
 
 struct Scene {
