@@ -27,7 +27,7 @@ function groupsPerLight() { return info.groups + (info.reradiation ? info.reradi
 
 // ---------- server calls ----------
 
-const { enc, splitFragment, specOf } = PrizmaState;
+const { enc, splitFragment, specOf, kindValue, chooseKind, fieldsOf } = PrizmaState;
 const kTokenKey = 'prizma-relight-token';
 let token = null;      // the run's secret: from the URL's fragment, kept in this tab's sessionStorage
 
@@ -113,6 +113,7 @@ function buildLightControls() {
     const name = light.name;
     uiLights[name] = parseSpec(light.spec);
     const fs = document.createElement('fieldset');
+    fs.dataset.light = name;
     fs.innerHTML = '<legend style="color:' + kPalette[index % kPalette.length] + '">light ' + name + '</legend>';
     const on = document.createElement('label');
     on.innerHTML = '<span class="k">on</span>';
@@ -122,6 +123,7 @@ function buildLightControls() {
     const kindRow = document.createElement('label');
     kindRow.innerHTML = '<span class="k">spectrum</span>';
     const kind = document.createElement('select');
+    kind.className = 'kind';
     for (const s of info.spectra) kind.add(new Option(s, 'named:' + s));
     kind.add(new Option('blackbody', 'blackbody'));
     kind.add(new Option('gaussian', 'gaussian'));
@@ -138,26 +140,25 @@ function buildLightControls() {
     custom.placeholder = 'box:500:560, 0.5, …';
     customRow.append(custom);
     const scale = slider('intensity', 0, 4, 0.01, (v) => { l().scale = v; onControlChange(); });
+    const rows = { temp, centre, fwhm, custom: customRow };  // each kind's parameter rows (fieldsOf)
+    for (const [field, row] of Object.entries(rows)) row.dataset.field = field;
     fs.append(on, kindRow, temp, centre, fwhm, customRow, scale);
     box.append(fs);
 
     onBox.addEventListener('change', () => { l().on = onBox.checked; onControlChange(); });
+    // A new kind shows its parameter rows at once (and the spec goes into the URL with them).
     kind.addEventListener('change', () => {
-      const v = kind.value;
-      if (v.startsWith('named:')) { l().kind = 'named'; l().named = v.slice(6); } else l().kind = v;
-      l().on = true;
+      uiLights[name] = chooseKind(l(), kind.value);
+      syncLightControls(name);
       onControlChange();
     });
     custom.addEventListener('change', () => { l().custom = custom.value; onControlChange(); });
     uiLights[name].sync = () => {
       const s = l();
       onBox.checked = s.on;
-      kind.value = s.kind === 'named' ? 'named:' + s.named : s.kind;
+      kind.value = kindValue(s);
       temp.set(s.temp); centre.set(s.centre); fwhm.set(s.fwhm); custom.value = s.custom; scale.set(s.scale);
-      temp.classList.toggle('hidden', s.kind !== 'blackbody');
-      centre.classList.toggle('hidden', s.kind !== 'gaussian');
-      fwhm.classList.toggle('hidden', s.kind !== 'gaussian');
-      customRow.classList.toggle('hidden', s.kind !== 'custom');
+      for (const [field, shown] of Object.entries(fieldsOf(s.kind))) rows[field].classList.toggle('hidden', !shown);
     };
   });
 }

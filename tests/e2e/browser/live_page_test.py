@@ -10,7 +10,9 @@
                                               `prizma-relight ... -o ref.png` within 2/255 per
                                               channel on >= 99.9 % of the pixels, and "Save" must
                                               write the very same image; pages of other origins
-                                              cannot use the server (cross_site.py)
+                                              cannot use the server (cross_site.py); every
+                                              spectrum kind of a light shows its parameters at
+                                              once and keeps them in the URL
 
 WORKDIR holds two.exr and one.exr (make_fixture). With --mri FILE (a render of data/scenes/mri.json,
 lights key and env) the browser test also draws that real-data file in several states. With --fluor
@@ -283,9 +285,54 @@ def check_pages(browser, relight, workdir, mri, fluor):
         states = list(refs)
         check(len(states) >= 5 and not np.array_equal(refs[states[0]], refs[states[4]]) and refs[states[1]].max() == 0,
               "the references differ between states, all-off is black")
+        check_spectrum_menu(browser, servers["two.exr"])
     finally:
         for srv in servers.values():
             check(srv.stop() == 0, "server for %s stopped cleanly" % srv.url)
+
+
+MENU_STATE = "light.side=D65&light.back=off&exposure=0&cmf=1931&display=sRGB&adapt=0"
+
+
+def check_spectrum_menu(browser, srv):
+    """Issue 25 item 1: choosing blackbody, gaussian or "other spec…" in a light's spectrum menu shows
+    that kind's parameter rows at once (and only those), and the spec, with what the rows then set,
+    goes into the URL and is drawn."""
+    from selenium.webdriver.support.ui import Select
+    open_page(browser, srv, MENU_STATE, "&")
+    fs = browser.find_element("css selector", "fieldset[data-light=side]")
+    rows = {f: fs.find_element("css selector", "[data-field=%s]" % f) for f in ("temp", "centre", "fwhm", "custom")}
+
+    def drawn_with(spec, what):
+        want = "light.side=" + spec
+        got = wait_for(browser, DRAWN, lambda r: r[0] and want + "&" in r[0] or r[1])
+        check(got[0] and want + "&" in got[0] and got[3].startswith("#" + want + "&"),
+              "%s: the URL and the drawn state hold %s (%r, error %r)" % (what, want, got[3], got[1]))
+
+    def set_row(field, value):
+        box = rows[field].find_element("css selector", "input[type=number], input[type=text]")
+        browser.execute_script("arguments[0].value = arguments[1]; arguments[0].dispatchEvent(new Event('change'));",
+                               box, value)
+
+    for kind, label, spec, visible, then in [
+        ("blackbody", "blackbody", "blackbody:3200K", {"temp"}, ("temp", "5600", "blackbody:5600K")),
+        ("gaussian", "gaussian", "gaussian:550:40", {"centre", "fwhm"}, ("fwhm", "25", "gaussian:550:25")),
+        ("custom", "other spec…", "gaussian:550:25", {"custom"}, ("custom", "box:500:560", "box:500:560")),
+    ]:
+        Select(fs.find_element("css selector", "select.kind")).select_by_visible_text(label)
+        shown = {f for f, row in rows.items() if row.is_displayed()}
+        check(shown == visible, "choosing %s shows its rows %s at once (shown: %s)" % (label, sorted(visible), sorted(shown)))
+        drawn_with(spec, "choosing " + label)
+        set_row(then[0], then[1])
+        drawn_with(then[2], "%s, its %s set to %s" % (label, then[0], then[1]))
+    # The URL's spec brings the menu and the rows back (a reload of the state-only address).
+    browser.refresh()
+    wait_for(browser, DRAWN, lambda r: r[2] >= 1 or r[1])
+    fs = browser.find_element("css selector", "fieldset[data-light=side]")
+    kind = Select(fs.find_element("css selector", "select.kind")).first_selected_option.text
+    text = fs.find_element("css selector", "[data-field=custom] input").get_attribute("value")
+    check(kind == "other spec…" and text == "box:500:560",
+          "a reload of the URL shows the spec in its row again (menu %r, spec %r)" % (kind, text))
 
 
 def save_from_page(browser, workdir, name):
