@@ -170,17 +170,13 @@ int run(const CliOptions& o) {
 
   spectral::ExrReadOptions read_options;
   read_options.verify_checksum = !o.no_verify;
-  // Spectral-basis coefficients (prizma-relight compress) are relit when present, unless --exact;
-  // the live page draws the bins on the GPU, so --serve reads them (and refuses a compact file).
-  read_options.read_coefficients = !o.exact && !o.serve;
+  // Spectral-basis coefficients (prizma-relight compress) are relit when present, unless --exact; the
+  // live page (--serve) then relights from them on the GPU too.
+  read_options.read_coefficients = !o.exact;
   read_options.allow_compact = true;
   relight::RelightSession session = spectral::allocating("reading " + o.input, [&] {
     return relight::RelightSession(spectral::read_spectral_exr(o.input, read_options), o.input, o.exact);
   });
-  if (o.serve && session.image().compact()) {
-    throw InputError(o.input, "compact file: it holds only spectral-basis coefficients, and the live page (--serve) "
-                              "needs the transport bins; serve the file it was made from");
-  }
   const relight::RelightSettings cli_settings = settings_from(o, session);
   session.apply(cli_settings);
   if (!o.output.empty()) {
