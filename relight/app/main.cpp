@@ -93,12 +93,13 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
     }
     seen.push_back(target);
   }
+  // The spectrum for every layer first (at each layer's scale: RelightSession::set_every_light),
+  // then the named layers, wherever they stand on the command line.
+  for (const std::string& arg : o.lights)
+    if (arg.find('=') == std::string::npos) session.set_every_light(s.lights, relight::parse_light_spec(arg, {"--light", {}}));
   for (const std::string& arg : o.lights) {
     const auto eq = arg.find('=');
-    if (eq == std::string::npos) {
-      const relight::LightSpec light = relight::parse_light_spec(arg, {"--light", {}});
-      std::fill(s.lights.begin(), s.lights.end(), light);
-    } else {
+    if (eq != std::string::npos) {
       const std::string name = arg.substr(0, eq);
       const int l = session.light_index(name, "--light");
       s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec(arg.substr(eq + 1), {"--light " + name, {}});
