@@ -2,6 +2,7 @@
 #   X/bin/prizma-render, prizma-relight, prizma-metamer
 #   X/lib/prizma/libprizma_imageio.so, libprizma_vdb.so  the modules loaded on first use
 #   X/share/prizma/{spectra,ocio,scenes}   the data the tools read (found relative to the executable)
+#   X/share/prizma/examples/colorchecker.exr  the spectral image relight.md's examples relight
 #   X/share/doc/prizma/                    README.md and docs/ (the user guide runs against this tree)
 include(GNUInstallDirs)
 
@@ -37,7 +38,7 @@ add_dependencies(prizma-installed ${_prizma_tools})
 # The modules the tools load on first use — the image module for PNG/TIFF/JPEG (imageio/) and the
 # VDB module for OpenVDB volumes (vdb/), both installed into lib/prizma — and the Python module
 # (python/; its own install rule): all are installed, so all are built.
-foreach(module prizma_imageio prizma_vdb prizma_python)
+foreach(module prizma_imageio prizma_vdb prizma_python prizma_colorchecker_example)
   if(TARGET ${module})
     add_dependencies(prizma-installed ${module})
   endif()
@@ -45,6 +46,8 @@ endforeach()
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/spectra ${PROJECT_SOURCE_DIR}/data/ocio ${PROJECT_SOURCE_DIR}/data/scenes
         DESTINATION ${PRIZMA_INSTALL_DATADIR} COMPONENT data)
+# The example spectral image relight.md relights (written at build time: relight/CMakeLists.txt).
+install(FILES ${PRIZMA_COLORCHECKER_EXR} DESTINATION ${PRIZMA_INSTALL_DATADIR}/examples COMPONENT data)
 
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT docs)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT docs)
