@@ -212,13 +212,17 @@ int merge_main(int argc, char** argv) {
 
 }  // namespace
 
+int inspect_main(int argc, char** argv);  // inspect.cpp
+
 int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "merge") return merge_main(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "inspect") return inspect_main(argc, argv);
 
   CLI::App app{"Renders a spectral volume scene to a spectral OpenEXR file: per pixel, per light and per bin\n"
                "the transport under unit white light, ready for prizma-relight.\n"
                "  prizma-render SCENE.json -o OUT.exr [options]\n"
-               "  prizma-render merge a.exr b.exr ... -o all.exr",
+               "  prizma-render merge a.exr b.exr ... -o all.exr\n"
+               "  prizma-render inspect VOLUME|SCENE   (values, histogram, material ranges)",
                kProgram};
   app.set_version_flag("--version", spectral::prizma_version());
   Options o;

@@ -94,6 +94,10 @@ def user_guide(run, out):
           "side.exr is float R, G, B (linear sRGB): %s" % list(spec.channelnames))
     # Step 5: the metamer matches under D65 and differs under F11; the hiding light hides it.
     text = "\n".join(block(out, n) for n in range(1, 10) if os.path.exists(os.path.join(out, "block-%d.txt" % n)))
+    # Step 2: inspect shows the histogram and the voxels each material's range takes.
+    claim(re.search(r"histogram +4 bins over \[100, 255\]", text) is not None and
+          re.search(r"rayleigh +\[50, 150\] \(normalised [^)]*\): [0-9 ]+ voxels", text) is not None and
+          "no material:" in text, "prizma-render inspect lists the histogram and the voxels of rayleigh and sphere")
     rows = de00_rows(text.split("hiding light")[0])
     claim(rows.get("match D65", 99) < 0.5 and rows.get("split F11", 0) > 5,
           "the metamer: dE00 %.2f under D65, %.2f under F11" % (rows.get("match D65", -1), rows.get("split F11", -1)))
