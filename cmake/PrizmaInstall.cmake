@@ -4,6 +4,7 @@
 #   X/share/prizma/{spectra,ocio,scenes}   the data the tools read (found relative to the executable)
 #   X/share/prizma/examples/colorchecker.exr  the spectral image relight.md's examples relight
 #   X/share/doc/prizma/                    README.md and docs/ (the user guide runs against this tree)
+#   X/share/man/man1/prizma-*.1, X/share/bash-completion/completions/prizma-*  (PrizmaToolDocs.cmake)
 include(GNUInstallDirs)
 
 set(PRIZMA_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/prizma" CACHE STRING
@@ -54,3 +55,6 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR
 
 # The Python module (`import prizma`): its own CMakeLists has its install() rule (COMPONENT python);
 # prizma-installed depends on it (above), so scripts/install builds and installs it too.
+
+# Man pages and bash completion, made from the tools' --help (cmake/PrizmaToolDocs.cmake).
+include(${CMAKE_CURRENT_LIST_DIR}/PrizmaToolDocs.cmake)

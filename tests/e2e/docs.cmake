@@ -31,3 +31,16 @@ foreach(script install demo)
            COMMAND ${PRIZMA_E2E_DIR}/docs/run-scripts ${script} ${_docs_src} ${CMAKE_BINARY_DIR} ${_docs_work}/scripts-${script})
   set_tests_properties(docs.scripts-${script} PROPERTIES LABELS docs TIMEOUT 300 RESOURCE_LOCK build_tree)
 endforeach()
+
+# The tools' --help examples, man pages and bash completion on the installed tree, through man and a
+# real bash in tmux (tests/e2e/docs/check_help.py).
+find_program(PRIZMA_TMUX tmux)
+find_program(PRIZMA_MAN man)
+if(PRIZMA_HELP2MAN AND PRIZMA_TMUX AND PRIZMA_MAN)
+  add_test(NAME docs.help COMMAND ${PRIZMA_SYSTEM_PYTHON3} ${PRIZMA_E2E_DIR}/docs/check_help.py
+           ${_docs_work}/home/.local ${_docs_work}/help)
+  set_tests_properties(docs.help PROPERTIES FIXTURES_REQUIRED docs_installed LABELS "docs;terminal" TIMEOUT 120
+                       RESOURCE_LOCK docs_work)
+else()
+  prizma_missing_tool_test(docs.help "help2man, tmux and man (scripts/setup installs them)")
+endif()
