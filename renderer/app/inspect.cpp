@@ -24,7 +24,7 @@ int inspect_main(int argc, char** argv) {
   app.add_option("input", input, "a scene file (.json) or a volume file (.nii, .nii.gz, .raw, .vdb)")
       ->required()
       ->check(spectral::non_empty_path());
-  app.add_option("--bins", bins, "histogram bins over the values that are not 0")->check(CLI::Range(1, 1000))->type_name("N");
+  app.add_option("--bins", bins, "histogram bins over the values that are not 0")->check(CLI::Range(1, 1000));
   if (const int rc = spectral::parse_command_line(app, argc - 1, argv + 1); rc >= 0) return rc;
   return spectral::run_tool("prizma-render", [&] {
     const render::InspectedVolume in = render::load_for_inspection(input);

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "environment_test_util.h"
 #include "prizma/render/environment_map.h"
 #include "prizma/render/rng.h"
 #include "prizma/render/scene.h"
@@ -138,15 +139,7 @@ TEST(EnvironmentConventions, EqualAreaDensityIntegratesToOneAndEveryTexelHasTheS
   }
   mean_l /= static_cast<double>(v.size());
   const EnvironmentMap map(n, n, v, 21.0, "test", EnvironmentConvention::PbrtEqualArea);
-  const int nt = 400, np = 800;
-  double integral = 0.0;
-  for (int i = 0; i < nt; ++i)
-    for (int j = 0; j < np; ++j) {
-      const double theta = kPi * (i + 0.5) / nt, phi = 2.0 * kPi * (j + 0.5) / np;
-      const Eigen::Vector3d d(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
-      integral += map.pdf(d) * std::sin(theta) * (kPi / nt) * (2.0 * kPi / np);
-    }
-  EXPECT_NEAR(integral, 1.0, 2e-3);
+  EXPECT_NEAR(testing::pdf_integral_over_sphere(map), 1.0, 2e-3);
   // Sampling is exactly proportional to radiance × solid angle: every draw's L / pdf is ∫ L dω.
   for (int k = 0; k < 10000; ++k) {
     Eigen::Vector3d d;
