@@ -56,6 +56,7 @@
 #include "bispectral_exr.h"
 #include "coefficients_exr.h"
 #include "float_hash.h"
+#include "missing_channels.h"
 #include "text_util.h"
 
 namespace prizma::spectral {
@@ -874,6 +875,13 @@ void verify_checksum(const std::string& p, const Imf::Header& header, const std:
                             kChecksumScheme + "<16 hex digits>, or " + kChecksumSchemeV1 + "<16 hex digits> in older files)");
   }
   if (stored == expected) return;
+  // Channels another tool left out (oiiotool --ch) are named, not taken for a re-encoding.
+  if (const std::string missing = detail::missing_channels(image, top != nullptr, stored.rfind(kChecksumScheme, 0) == 0);
+      !missing.empty()) {
+    throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) + ": the file lacks " + missing +
+                            ", which the checksum covers: another tool left them out (oiiotool --ch, say); " +
+                            unverified_read + " reads what is there");
+  }
   const std::string signs = reencoding_signs(header);
   if (signs.empty()) {
     throw InputError(p, "pixel data do not match " + std::string(kAttrChecksum) + " (the file is damaged; " +

@@ -3,6 +3,7 @@
 // setting the renderer's cancellation flag when one arrives. render() then returns the passes
 // completed so far. Integer arguments are checked as the tools check their options.
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>  // Scene::warnings → a list of str
 
 #include <atomic>
 #include <charconv>

@@ -39,6 +39,11 @@ DefaultLights read_default_lights(const spectral::SpectralImage& image, const st
       LightSpec placeholder;
       placeholder.text = spec;
       placeholder.off = true;
+      try {  // the recorded factors, which a spectrum given for every light keeps (set_every_light)
+        placeholder.scale = spectral::light_spec_scale(spec, {context, {}});
+      } catch (const InputError&) {
+        placeholder.scale = 1.0;
+      }
       out.lights.push_back(std::move(placeholder));
       // Keep the inner input when it is not the context (the CSV's path, say).
       out.errors.push_back(e.input() == context ? e.reason() : e.what());
@@ -121,12 +126,24 @@ void RelightSession::apply(RelightSettings settings) {
   m_dirty = true;
 }
 
+void RelightSession::set_every_light(std::vector<LightSpec>& lights, const LightSpec& given) const {
+  if (lights.size() != m_light_names.size()) {
+    throw InputError("lights", "expected " + std::to_string(m_light_names.size()) + " lights, got " +
+                                   std::to_string(lights.size()));
+  }
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const LightSpec& now = lights[l];
+    const bool placeholder = !m_default_errors[l].empty() && now.off && now.text == m_default_lights[l].text;
+    lights[l] = spectral::at_light_scale(given, placeholder || !now.off ? now.scale : 0.0);
+  }
+}
+
 void RelightSession::set_light(std::string_view name, std::string_view spec) {
   RelightSettings s = m_settings;
   const std::string input = name.empty() ? "light" : "light " + std::string(name);
   const LightSpec light = parse_light_spec(spec, {input, {}});
   if (name.empty()) {
-    std::fill(s.lights.begin(), s.lights.end(), light);
+    set_every_light(s.lights, light);
   } else {
     s.lights[static_cast<std::size_t>(light_index(name, "light"))] = light;
   }

@@ -4,7 +4,9 @@ if(NOT TARGET prizma-relight)
   return()
 endif()
 
-add_executable(prizma_relight_make_fixture ${PRIZMA_E2E_DIR}/relight/make_fixture.cpp)
+add_executable(prizma_relight_make_fixture ${PRIZMA_E2E_DIR}/relight/make_fixture.cpp
+               ${PROJECT_SOURCE_DIR}/relight/examples/colorchecker_chart.cpp)
+target_include_directories(prizma_relight_make_fixture PRIVATE ${PROJECT_SOURCE_DIR}/relight/examples)
 target_link_libraries(prizma_relight_make_fixture PRIVATE prizma::spectral PkgConfig::OIIO)
 prizma_set_warnings(prizma_relight_make_fixture)
 
