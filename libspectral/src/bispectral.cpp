@@ -14,7 +14,7 @@
 #include <sstream>
 
 #include "bispectral_exr.h"
-#include "float_hash.h"
+#include "exr/checksum.h"
 #include "prizma/spectral/error.h"
 #include "text_util.h"
 
@@ -24,7 +24,6 @@ namespace {
 constexpr double kSpeedOfLight_m_per_s = 299792458.0;
 constexpr float kHalfMax = 65504.0f;
 // Offset basis of the bispectral values (the diagonal's cbf29ce484222325 rotated by 16 bits).
-constexpr std::uint64_t kFnvBasisReradiation = 0x2325cbf29ce48422ULL;
 
 double unit_factor(const std::string& prefix) {
   static const std::map<std::string, double> kFactors = {
@@ -47,7 +46,7 @@ double to_nm(const std::string& name, std::string number, const std::string& pre
   return nm;
 }
 
-std::uint64_t hash_values(const float* v, std::size_t n) { return detail::hash_float_bits(v, n, kFnvBasisReradiation); }
+std::uint64_t hash_values(const float* v, std::size_t n) { return exr::layer_hash(exr::LayerKind::Bispectral, v, n); }
 
 std::string pair_text(const SpectralImage& image, const BinPair& pr) {
   std::ostringstream os;
