@@ -103,12 +103,12 @@ void validate_image(const SpectralImage& image, const ExrWriteOptions& opts, con
   }
 }
 
-// The per-bin layers: the lights' transport (one light: top level; two or more: per light, and their
-// sum at top level, held in `sum`) and their variance.
+// The per-bin layers: the lights' transport (one light: top level; two or more, or bispectral terms:
+// per light, and their sum at top level, held in `sum`) and their variance.
 std::vector<OutLayer> bin_layers(const SpectralImage& image, const ExrWriteOptions& opts, std::vector<float>& sum,
                                  const std::string& p) {
   const int bins = image.bins.size();
-  const bool multi = image.lights.size() >= 2;
+  const bool multi = exr::has_named_layers(image);
   std::vector<OutLayer> layers;
   if (image.compact()) {
     // no transport layers
@@ -325,7 +325,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   Imf::Header header(image.width, image.height);
   Imf::FrameBuffer fb;
   std::uint64_t checksum = add_bin_layers(layers, image, type, header, fb);
-  const bool multi = image.lights.size() >= 2;
+  const bool multi = exr::has_named_layers(image);
   detail::ReradiationBuffers rerad_buffers;  // bispectral terms (fluorescence; none for a diagonal image)
   checksum += detail::add_reradiation_for_write(image, multi, half_out, header, fb, rerad_buffers, p);
   std::list<std::vector<half>> coefficient_buffers;  // spectral-basis coefficients (half whatever the pixel type)

@@ -114,7 +114,7 @@ namespace prizma::spectral {
 
 std::string spectral_pixel_checksum(const SpectralImage& image) {
   std::uint64_t sum = exr::light_layers_hash(image);
-  if (image.lights.size() >= 2) {
+  if (exr::has_named_layers(image)) {
     const std::vector<float> total = exr::sum_of_lights(image);
     sum += exr::layer_hash(exr::LayerKind::Sum, total.data(), total.size());
   }

@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "prizma/spectral/spectral_exr.h"
+
 namespace prizma::spectral::exr {
 
 inline constexpr const char* kLayoutVersion = "1.0";
@@ -63,6 +65,12 @@ constexpr const LayerKindInfo& layer_kind(LayerKind k) {
     if (info.kind == k) return info;
   return kLayerKinds[0];  // unreachable: every kind has a row
 }
+
+// A file holds a layer per light, named after it, and their sum at top level for readers of the
+// published layout, when it has two or more lights or bispectral terms (the top level then holds the
+// layout's re-radiation pairs, which cannot hold all of Prizma's: bispectral.cpp); else its one
+// light is the top level.
+inline bool has_named_layers(const SpectralImage& image) { return image.lights.size() >= 2 || !image.reradiation.empty(); }
 
 // Threads for compressing and decompressing chunks (starts OpenEXR's global pool on first use).
 int io_threads();
