@@ -1,5 +1,7 @@
 #include "missing_channels.h"
 
+#include "exr/exr_common.h"
+
 #include <nlohmann/json.hpp>
 
 #include <vector>
@@ -8,8 +10,8 @@ namespace prizma::spectral::detail {
 
 std::string missing_channels(const SpectralImage& image, bool has_top, bool covers_top) {
   std::vector<std::string> missing;
-  if (covers_top && !has_top && image.lights.size() >= 2 && !image.compact()) {
-    missing.push_back("the top-level T channels (T.<λ>nm: the sum of the lights, in every file of two or more lights)");
+  if (covers_top && !has_top && exr::has_named_layers(image) && !image.compact()) {
+    missing.push_back("the top-level T channels (T.<λ>nm: the sum of the lights, in every file with named light layers)");
   }
   std::vector<std::string> with, without;
   for (const auto& light : image.lights) (light.variance.empty() ? without : with).push_back(light.name);

@@ -193,6 +193,7 @@ int run(const CliOptions& o) {
               << (spectral::data_dir() / cmf_table(s.relight.cmf)).string() << ")\n"
               << "prizma-relight: OCIO config " << session.display().config_path().string() << ", "
               << session.display().description() << "\n";
+    for (const std::string& note : session.image().info.notes) std::cerr << "prizma-relight: note: " << note << "\n";
     const std::string coverage =
         spectral::cmf_coverage_note(spectral::ColorMatching::get(s.relight.cmf), session.image().bins);
     if (!coverage.empty()) std::cerr << "prizma-relight: note: " << coverage << "\n";

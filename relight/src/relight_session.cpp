@@ -284,7 +284,7 @@ void RelightSession::save(const std::filesystem::path& path, const std::string& 
 ImageMetadata RelightSession::metadata() const {
   std::vector<spectral::LightRecord> lights;
   for (std::size_t l = 0; l < m_light_names.size(); ++l) {
-    lights.push_back({.name = m_light_names[l], .spectrum = m_settings.lights[l].text});
+    lights.push_back(spectral::light_record(m_light_names[l], m_settings.lights[l].text));
   }
   std::ostringstream exposure;
   exposure << m_settings.relight.exposure_ev;

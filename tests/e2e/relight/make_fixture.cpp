@@ -7,6 +7,9 @@
 //   existing.png   a file a failing run must leave untouched ("keep me")
 //   colorchecker.exr  the example chart of docs/relight.md (relight/examples/colorchecker_chart.h;
 //                     bins from 380 nm, below the CIE 2012 tables)
+//   reference400.exr  a plain reflective file as the JCGT reference writer makes one: T.400nm …
+//                     T.700nm, 100 nm apart, no prizma: attributes (its inferred first edge, 350 nm,
+//                     is clamped to the tables' 360 nm)
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
@@ -71,6 +74,18 @@ int main(int argc, char** argv) {
       !out->close()) {
     std::cerr << "make_fixture: cannot write rgb.exr\n";
     return 1;
+  }
+  {
+    const float t[4 * 4] = {0.2f, 0.4f, 0.6f, 0.8f, 0.2f, 0.4f, 0.6f, 0.8f, 0.2f, 0.4f, 0.6f, 0.8f, 0.2f, 0.4f, 0.6f, 0.8f};
+    auto ref = OIIO::ImageOutput::create((dir / "reference400.exr").string());
+    OIIO::ImageSpec rs(2, 2, 4, OIIO::TypeDesc::FLOAT);
+    rs.channelnames = {"T.400nm", "T.500nm", "T.600nm", "T.700nm"};
+    rs.attribute("spectralLayoutVersion", "1.0");
+    if (!ref || !ref->open((dir / "reference400.exr").string(), rs) || !ref->write_image(OIIO::TypeDesc::FLOAT, t) ||
+        !ref->close()) {
+      std::cerr << "make_fixture: cannot write reference400.exr\n";
+      return 1;
+    }
   }
   return 0;
 }
