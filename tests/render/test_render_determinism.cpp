@@ -138,7 +138,7 @@ TEST(RenderDeterminism, InfoRecordsProvenance) {
   EXPECT_EQ(img.info.sample_range, "0:4");
   EXPECT_EQ(img.info.seed, 42);
   EXPECT_EQ(img.info.scene_hash, "test");
-  EXPECT_EQ(img.info.wavelength_sampling, "spectral-tracking");
+  EXPECT_EQ(img.info.wavelength_sampling, "spectral-mis");  // auto, resolved: the estimator that ran
   EXPECT_FALSE(img.info.version.empty());
   ASSERT_EQ(img.lights.size(), 2u);
   EXPECT_EQ(img.lights[0].name, "env");
