@@ -38,7 +38,7 @@ struct Options {
   std::string out = "docs/results/error_vs_time.csv";
   std::uint64_t seed = 1;
   bool references_only = false;
-  std::string bins;  // a bin layout for every scene instead of its own (spectral MIS's rule: narrower spectra)
+  std::string bins;  // a bin layout for every scene instead of its own (empty: the scene's)
 };
 
 }  // namespace
@@ -46,10 +46,11 @@ struct Options {
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Error versus time of each wavelength-sampling method against a high-sample reference"};
-  app.add_option("--scenes", o.scenes, "grey, cube, metamers, mri");
+  app.add_option("--scenes", o.scenes, "grey, cube, metamers, mri, peer, any data/scenes/NAME, NAME-grey (bin-averaged)");
   app.add_option("--methods", o.methods,
                  "single, single-nogrid, spectral (auto event probabilities), spectral-nogrid, spectral-max, "
-                 "spectral-average, spectral-mixed, spectral-implicit, spectral-sobol, single-sobol (the Sobol' sampler)");
+                 "spectral-average, spectral-mixed, spectral-implicit, spectral-sobol, single-sobol (the Sobol' sampler), "
+                 "spectral-tracking (= spectral), spectral-mis");
   app.add_option("--size", o.size, "image width and height in pixels");
   app.add_option("--ref-spp", o.ref_spp, "reference samples per pixel (spectral tracking, grid)");
   app.add_option("--max-spp", o.max_spp, "largest sample count of the measured renders (powers of 2 up to it)");
