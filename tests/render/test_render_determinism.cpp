@@ -15,17 +15,7 @@ namespace {
 using spectral::Spectrum;
 
 using testing::chromatic_scene;
-
-bool same_bits(const spectral::SpectralImage& a, const spectral::SpectralImage& b) {
-  if (a.lights.size() != b.lights.size()) return false;
-  for (std::size_t l = 0; l < a.lights.size(); ++l) {
-    const auto& x = a.lights[l].data;
-    const auto& y = b.lights[l].data;
-    if (x.size() != y.size() || std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) != 0) return false;
-    if (a.lights[l].variance != b.lights[l].variance) return false;
-  }
-  return true;
-}
+using testing::same_bits;
 
 TEST(RenderDeterminism, ThreadCountDoesNotChangeABit) {
   Scene s = chromatic_scene(16);

@@ -36,21 +36,11 @@ using testing::kPi;
 using testing::kSe;
 using testing::make_material;
 using testing::pixel_average;
+using testing::same_bits;
 
 Scene with_mis(Scene s) {
   s.settings.wavelength_sampling = WavelengthSampling::SpectralMis;
   return s;
-}
-
-bool same_bits(const spectral::SpectralImage& a, const spectral::SpectralImage& b) {
-  if (a.lights.size() != b.lights.size()) return false;
-  for (std::size_t l = 0; l < a.lights.size(); ++l) {
-    const auto& x = a.lights[l].data;
-    const auto& y = b.lights[l].data;
-    if (x.size() != y.size() || std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) != 0) return false;
-    if (a.lights[l].variance != b.lights[l].variance) return false;
-  }
-  return true;
 }
 
 // Bin average over [lo, hi] of e^{−D σ(λ)} for σ linear in λ: (e^{−D σ(lo)} − e^{−D σ(hi)}) / (D (σ(hi) − σ(lo))).
