@@ -37,16 +37,14 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
   // density of a tentative collision followed by event e is μ̄_k·T_k·P_e,k (T_k = e^{−∫ μ̄_k}); lane
   // i's contribution factor is T_i·σe,i. Only the ratios T_k/T_j enter the update, so only the depths
   // of cells with a spectral bound are summed: elsewhere every lane's majorant is the cell's, and
-  // its depth is the same for all lanes.
+  // its depth is the same for all lanes. (One function of ~90 lines: the depth runs and the current
+  // cell are state that the segment and collision callbacks share; the collision is collide_mis.)
   const int n = v.n, j = v.hero;
   PathWork& pw = s.work;
   MaterialCache& cache = s.cache;
-  const Lanes<0>& w = v.w;
-  const Lanes<0> sa = lanes_of<0>(pw.sigma_a, n), ss = lanes_of<0>(pw.sigma_s, n), sn = lanes_of<0>(pw.sigma_n, n);
   const Lanes<0> rate = lanes_of<0>(pw.mis_rate, n);    // μ̄_k of the current cell
   const Lanes<0> depth = lanes_of<0>(pw.mis_depth, n);  // ∫ μ̄_k over bound cells since the last collision
   const Lanes<0> ratio = lanes_of<0>(pw.mis_ratio, n);  // T_k / T_j at a collision
-  const Lanes<0> b = lanes_of<0>(pw.mis_factor, n);     // technique densities' factors
   auto sigma_t_of = [&](std::uint16_t m) { return lanes_of<0>(std::as_const(cache.sigma_t), n, m); };
 
   // Runs of bound cells of one material m add up the scalar Σ d_max·ℓ, put on the lanes as that
@@ -120,75 +118,92 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
       rate = sigma_t_of(cell.material) * cell.density_max;
     else
       rate = tc.mu;
-    std::uint16_t m;
-    float d;
-    lookup(tc.p, m, d);
-    if (m == Medium::kEmpty || d <= 0.0f) {  // σt = 0: a null collision for every technique
-      b = ratio * rate;
-      if (!mis_update(v, b, b)) {
-        end = FlightEnd::Absorbed;
-        return false;
-      }
-      return true;
-    }
-    if (!cache.holds(m)) evaluate_material(m, s);
-    {  // σn,k = μ̄_k − σt,k with the lane's own majorant
-      const float* st = cache.sigma_t.data() + static_cast<std::size_t>(m) * n;
-      const float* al = cache.albedo.data() + static_cast<std::size_t>(m) * n;
-      for (int k = 0; k < n; ++k) collision_lane(d, rate[k], st[k], al[k], sa[k], ss[k], sn[k]);
-    }
-    if (m_emits[m]) {
-      // Emission at every tentative collision (pbrt-v4's estimator): lane i's ∫ T_i σa,i Le,i ds
-      // sampled at density Σ_k c_k p_k μ̄_k T_k.
-      const float total = partial::sum(v.mix, n), mix = partial::sum(v.mix * ratio * rate, n);
-      if (mix > 0.0f)
-        v.lanes(v.em) += w * ratio * sa * lanes_of<0>(std::as_const(cache.emission_le), n, m) * (total / mix);
-    }
-    const bool implicit = m_events[m] == EventProbabilities::Implicit;
-    bool scatter;
-    if (!implicit) {  // analog: a_i = b_i = T_i σe,i
-      const float c = sa[j] + ss[j] + sn[j];
-      const float xi = rng.uniform() * c;
-      if (xi < sa[j]) {
-        end = FlightEnd::Absorbed;
-        return false;
-      }
-      scatter = xi < sa[j] + ss[j];
-      b = ratio * (scatter ? ss : sn);
-      if (!mis_update(v, b, b)) {
-        end = FlightEnd::Absorbed;
-        return false;
-      }
-    } else {
-      // Implicit capture: P_s,k = σs,k/(σs,k + σn,k) (1 when both are 0), a_i = T_i σe,i,
-      // b_k = T_k μ̄_k P_e,k; a_i / b_i = (σs,i + σn,i)/μ̄_i is lane i's survival.
-      const float cj = ss[j] + sn[j];
-      scatter = cj > 0.0f ? rng.uniform() * cj < ss[j] : true;
-      const Lanes<0> a = lanes_of<0>(pw.mis_contribution, n);
-      const Lanes<0>& coef = scatter ? ss : sn;
-      a = ratio * coef;
-      const float none = scatter ? 1.0f : 0.0f;
-      for (int k = 0; k < n; ++k) {
-        const float ck = ss[k] + sn[k];
-        b[k] = ratio[k] * rate[k] * (ck > 0.0f ? coef[k] / ck : none);
-      }
-      if (!mis_update(v, a, b)) {
-        end = FlightEnd::Absorbed;
-        return false;
-      }
-    }
-    if (!scatter) return true;
-    v.pos = tc.p;
-    v.material = m;
-    v.isotropic = false;
-    end = FlightEnd::Scattered;
-    return false;
+    return collide_mis(v, tc, end, rng, s);
   });
   if (!reached) return end;
   // Escaped: no collision up to the exit, density T_k for technique k, contribution T_i.
   count_to(cell_t1);
   transmittance_ratios();
   return mis_update(v, ratio, ratio) ? FlightEnd::Escaped : FlightEnd::Absorbed;
+}
+
+bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, FlightEnd& end, Rng& rng,
+                             PathScratch& s) const {
+  // A tentative collision of the hero's free flight (free_flight_mis has put the transmittance ratios
+  // T_k/T_j and the lanes' majorants μ̄_k of its cell into work.mis_ratio and work.mis_rate): the
+  // emission layer, then the hero's event and every lane's update. True: a null collision, the walk
+  // goes on; false with `end` Absorbed or Scattered (v.pos, v.material set).
+  const int n = v.n, j = v.hero;
+  PathWork& pw = s.work;
+  MaterialCache& cache = s.cache;
+  const Lanes<0>& w = v.w;
+  const Lanes<0> sa = lanes_of<0>(pw.sigma_a, n), ss = lanes_of<0>(pw.sigma_s, n), sn = lanes_of<0>(pw.sigma_n, n);
+  const Lanes<0> rate = lanes_of<0>(pw.mis_rate, n), ratio = lanes_of<0>(pw.mis_ratio, n);
+  const Lanes<0> b = lanes_of<0>(pw.mis_factor, n);
+  std::uint16_t m;
+  float d;
+  lookup(tc.p, m, d);
+  if (m == Medium::kEmpty || d <= 0.0f) {  // σt = 0: a null collision for every technique
+    b = ratio * rate;
+    if (!mis_update(v, b, b)) {
+      end = FlightEnd::Absorbed;
+      return false;
+    }
+    return true;
+  }
+  if (!cache.holds(m)) evaluate_material(m, s);
+  {  // σn,k = μ̄_k − σt,k with the lane's own majorant
+    const float* st = cache.sigma_t.data() + static_cast<std::size_t>(m) * n;
+    const float* al = cache.albedo.data() + static_cast<std::size_t>(m) * n;
+    for (int k = 0; k < n; ++k) collision_lane(d, rate[k], st[k], al[k], sa[k], ss[k], sn[k]);
+  }
+  if (m_emits[m]) {
+    // Emission at every tentative collision (pbrt-v4's estimator): lane i's ∫ T_i σa,i Le,i ds
+    // sampled at density Σ_k c_k p_k μ̄_k T_k.
+    const float total = partial::sum(v.mix, n), mix = partial::sum(v.mix * ratio * rate, n);
+    if (mix > 0.0f)
+      v.lanes(v.em) += w * ratio * sa * lanes_of<0>(std::as_const(cache.emission_le), n, m) * (total / mix);
+  }
+  const bool implicit = m_events[m] == EventProbabilities::Implicit;
+  bool scatter;
+  if (!implicit) {  // analog: a_i = b_i = T_i σe,i
+    const float c = sa[j] + ss[j] + sn[j];
+    const float xi = rng.uniform() * c;
+    if (xi < sa[j]) {
+      end = FlightEnd::Absorbed;
+      return false;
+    }
+    scatter = xi < sa[j] + ss[j];
+    b = ratio * (scatter ? ss : sn);
+    if (!mis_update(v, b, b)) {
+      end = FlightEnd::Absorbed;
+      return false;
+    }
+  } else {
+    // Implicit capture: P_s,k = σs,k/(σs,k + σn,k) (1 when both are 0), a_i = T_i σe,i,
+    // b_k = T_k μ̄_k P_e,k; a_i / b_i = (σs,i + σn,i)/μ̄_i is lane i's survival.
+    const float cj = ss[j] + sn[j];
+    scatter = cj > 0.0f ? rng.uniform() * cj < ss[j] : true;
+    const Lanes<0> a = lanes_of<0>(pw.mis_contribution, n);
+    const Lanes<0>& coef = scatter ? ss : sn;
+    a = ratio * coef;
+    const float none = scatter ? 1.0f : 0.0f;
+    for (int k = 0; k < n; ++k) {
+      const float ck = ss[k] + sn[k];
+      b[k] = ratio[k] * rate[k] * (ck > 0.0f ? coef[k] / ck : none);
+    }
+    if (!mis_update(v, a, b)) {
+      end = FlightEnd::Absorbed;
+      return false;
+    }
+  }
+  if (!scatter) return true;
+  v.pos = tc.p;
+  v.material = m;
+  v.isotropic = false;
+  end = FlightEnd::Scattered;
+  return false;
+
 }
 
 bool PathTracer::sample_phase_hero(PathState<0>& v, ConstLanes<0> g, bool g_constant, Rng& rng, PathScratch& s) const {

@@ -23,6 +23,7 @@ namespace prizma::render {
 
 template <int kN>
 class ConstLanes;  // renderer/src/lanes.h
+struct TentativeCollision;  // renderer/src/majorant_sampler.h
 
 // Counters a path adds to (summed per thread, then over threads).
 struct PathCounters {
@@ -180,6 +181,7 @@ class PathTracer {
   // Spectral MIS: the hero's free flight, its phase lobe, and the update of the lanes' weights and
   // densities by an event's factors a (contributions) and b (densities); false when nothing is left.
   FlightEnd free_flight_mis(PathState<0>& v, Rng& rng, PathScratch& s) const;
+  bool collide_mis(PathState<0>& v, const TentativeCollision& tc, FlightEnd& end, Rng& rng, PathScratch& s) const;
   bool sample_phase_hero(PathState<0>& v, ConstLanes<0> g, bool g_constant, Rng& rng, PathScratch& s) const;
   bool mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) const;
   template <int kLanes>
