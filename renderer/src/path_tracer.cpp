@@ -15,6 +15,7 @@
 #include "tracer/scattering.inl"
 #include "tracer/fluorescent_event.inl"
 #include "tracer/spectral_mis.inl"
+#include "tracer/shadow_mis.inl"
 
 namespace prizma::render {
 
@@ -107,9 +108,10 @@ void PathTracer::prepare(PathScratch& s, int lanes) const {
   PathWork& w = s.work;
   for (auto* v : {&w.weight, &w.transmittance, &w.optical_depth, &w.phase, &w.sigma_a, &w.sigma_s, &w.sigma_n})
     v->assign(n, 0.0f);
-  if (m_mis)
-    for (auto* v : {&w.mis_pdf, &w.mis_rate, &w.mis_depth, &w.mis_ratio, &w.mis_factor, &w.mis_contribution})
-      v->assign(n, 0.0f);
+  // (Spectral MIS's; sized for every tracer, so that estimate_transmittance_mis can be called.)
+  for (auto* v : {&w.mis_pdf, &w.mis_rate, &w.mis_depth, &w.mis_ratio, &w.mis_factor, &w.mis_contribution,
+                  &w.shadow_pdf})
+    v->assign(n, 0.0f);
   PathResult& out = s.out;
   out.environment.assign(n, 0.0f);
   out.emission.assign(n, 0.0f);

@@ -31,7 +31,14 @@ void PathTracer::estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, boo
     if (!m_lights[l].sample(v.pos, rng, ls)) continue;
     const Eigen::Vector3d& wl = ls.direction;
     const auto cos_theta = static_cast<float>(v.dir.dot(wl));
-    transmittance<kLanes>(v.pos, wl, rng, s, ls.distance);
+    if constexpr (kLanes == 0) {
+      if (v.hero >= 0)  // spectral MIS: the shadow ray at the hero's rates (shadow_mis.inl)
+        transmittance_mis(v.pos, wl, v.mix, v.hero, rng, s, ls.distance);
+      else
+        transmittance<kLanes>(v.pos, wl, rng, s, ls.distance);
+    } else {
+      transmittance<kLanes>(v.pos, wl, rng, s, ls.distance);
+    }
     const Lanes<kLanes> out = v.lanes(v.dir_out + l * static_cast<std::size_t>(n));
     if (g_constant) {
       const float p = hg_phase(cos_theta, g[0]);

@@ -23,6 +23,8 @@ namespace prizma::render {
 
 template <int kN>
 class ConstLanes;  // renderer/src/lanes.h
+template <int kN>
+class Lanes;
 struct TentativeCollision;  // renderer/src/majorant_sampler.h
 
 // Counters a path adds to (summed per thread, then over threads).
@@ -86,6 +88,9 @@ struct PathWork {
   // densities ρ, the current cell's per-lane majorants, their optical depths since the last
   // collision, the transmittance ratios T_k/T_j, and an event's factors on densities and contributions.
   std::vector<float> mis_pdf, mis_rate, mis_depth, mis_ratio, mis_factor, mis_contribution;
+  // Spectral MIS for shadow rays (renderer/src/tracer/shadow_mis.inl): the lanes' shadow-ray densities
+  // over the hero's, renormalised.
+  std::vector<float> shadow_pdf;
 };
 
 // What trace() returns per lane (overwritten by every path): radiance at unit white.
@@ -149,6 +154,11 @@ class PathTracer {
   // scratch.work.transmittance (for tests and benches).
   void estimate_transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max, Rng& rng,
                               PathScratch& scratch) const;
+  // The same under spectral MIS (renderer/src/tracer/shadow_mis.inl): the points drawn at lane
+  // `hero`'s own residual rates, every lane weighted by the balance heuristic over the lanes with
+  // the path's normalised densities rho (lanes values, summing to lanes; all 1 at a path's start).
+  void estimate_transmittance_mis(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
+                                  const std::vector<float>& rho, int hero, Rng& rng, PathScratch& s) const;
   const MajorantGrid& grid() const { return m_grid; }
   // Index in scene.lights of the emission light (Light::emission), or −1.
   int emission_light() const { return m_emission_light; }
@@ -194,6 +204,15 @@ class PathTracer {
   template <int kLanes>
   void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s,
                      double t_max = std::numeric_limits<double>::infinity()) const;
+  // Spectral MIS's: residual ratio tracking at the hero lane's own rates, every lane weighted by the
+  // balance heuristic over the lanes with the path's normalised densities rho (shadow_mis.inl).
+  void transmittance_mis(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, ConstLanes<0> rho, int hero,
+                         Rng& rng, PathScratch& s, double t_max) const;
+  // σt,i(p) − σc,i per lane into r: the medium at p less the cell's control.
+  void residual_at(const Eigen::Vector3d& p, const CellControl& control, Lanes<0> r, PathScratch& s) const;
+  // Ratio tracking's Russian roulette on T with depth_lo a lower bound of the depth still to apply;
+  // false: stopped (T = 0).
+  bool transmittance_roulette(Lanes<0> T, float depth_lo, Rng& rng) const;
   // A path leaving the medium along dir: the environment maps' radiance, MIS-weighted against NEE
   // by the density phase_pdf its direction was drawn with (0 = a camera ray), times the weights,
   // added to lights_out (the light layers: s.out.directional, or after a fluorescent event the in
