@@ -10,7 +10,7 @@ set(_docs_run ${PRIZMA_SYSTEM_PYTHON3} ${PRIZMA_E2E_DIR}/docs/run-doc)
 add_test(NAME docs.install COMMAND ${_docs_run} install --build ${CMAKE_BINARY_DIR} --work ${_docs_work})
 set_tests_properties(docs.install PROPERTIES FIXTURES_SETUP docs_installed LABELS docs TIMEOUT 120
                      RESOURCE_LOCK docs_work)
-add_test(NAME docs.user-guide COMMAND ${_docs_run} run --doc ${_docs_dir}/user-guide.md --work ${_docs_work})
+add_test(NAME docs.user-guide COMMAND ${_docs_run} run --doc ${_docs_dir}/user-guide.md --work ${_docs_work} --other-home)
 add_test(NAME docs.metamerism COMMAND ${_docs_run} run --doc ${_docs_dir}/metamerism.md --work ${_docs_work} --data-link)
 add_test(NAME docs.relight COMMAND ${_docs_run} run --doc ${_docs_dir}/relight.md --work ${_docs_work} --data-link)
 set_tests_properties(docs.user-guide docs.metamerism docs.relight PROPERTIES FIXTURES_REQUIRED docs_installed
