@@ -167,3 +167,30 @@ def test_serve_stops_when_python_exits(tiny_exr, tmp_path):
     while os.path.exists(f"/proc/{pid}") and time.monotonic() < deadline:
         time.sleep(0.05)
     assert not os.path.exists(f"/proc/{pid}")
+
+
+def test_serve_page_draws_in_chromium(tiny_exr, tmp_path):
+    """The page prizma.serve opens draws the image in memory in headless Chromium (SwiftShader WebGL2),
+    as tests/e2e/browser's live-page tests open the tool's; its screenshot is left in the test's folder."""
+    webdriver = pytest.importorskip("selenium.webdriver")
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.support.ui import WebDriverWait
+    if not os.access("/usr/bin/chromedriver", os.X_OK):
+        pytest.skip("chromium-driver is not installed (scripts/setup installs it)")
+    opts = webdriver.ChromeOptions()
+    for flag in ["--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--enable-unsafe-swiftshader",
+                 "--use-angle=swiftshader", "--disable-background-networking", "--window-size=1400,900",
+                 "--user-data-dir=" + str(tmp_path / "profile")]:
+        opts.add_argument(flag)
+    with prizma.serve(prizma.read(tiny_exr), save_dir=tmp_path) as server:
+        browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=opts)
+        try:
+            browser.get(server.url)
+            WebDriverWait(browser, 240, poll_frequency=0.1).until(
+                lambda b: b.execute_script("return Number(document.getElementById('relit').dataset.frame) >= 1"))
+            canvas = browser.execute_script("const c = document.getElementById('relit'); return [c.width, c.height];")
+            assert canvas[0] > 0 and canvas[1] > 0
+            assert "image.exr" in browser.find_element("tag name", "body").text
+            browser.save_screenshot(str(tmp_path / "served.png"))
+        finally:
+            browser.quit()
