@@ -27,6 +27,13 @@ _STOP_SECONDS = 10  # how long stop() waits for the tool to end after SIGTERM be
 _running = _weakref.WeakSet()  # servers stopped at interpreter exit
 
 
+def _refusal(input, reason):
+    """InputError as the package makes them: "input: reason", with .input and .reason."""
+    e = InputError(f"{input}: {reason}")
+    e.input, e.reason = input, reason
+    return e
+
+
 def _error_from_tool(code, stderr):
     """The exception a failed start of prizma-relight stands for: its one-line message after
     "prizma-relight: error: ", InputError (exit 2, with .input and .reason) or RuntimeFailure."""
@@ -34,9 +41,8 @@ def _error_from_tool(code, stderr):
     message = lines[-1] if lines else f"prizma-relight --serve ended with status {code} before serving"
     message = message.split("prizma-relight: error: ", 1)[-1]
     if code == 2:
-        e = InputError(message)
-        e.input, _, e.reason = message.partition(": ")
-        return e
+        input, _, reason = message.partition(": ")
+        return _refusal(input, reason)
     return RuntimeFailure(message)
 
 
@@ -51,11 +57,11 @@ def _tool_arguments(lights, exposure, display):
     if isinstance(lights, dict):
         for name, spec in lights.items():
             if spec is not None and not isinstance(spec, str):
-                raise InputError(f'lights["{name}"]: prizma.serve takes spec strings (a measured spectrum: '
-                                 f'a csv: file, docs/spectra.md)')
+                raise _refusal(f'lights["{name}"]', "prizma.serve takes spec strings (a measured spectrum: a csv: "
+                                                    "file, docs/spectra.md)")
             args += ["--light", f"{name}={'off' if spec is None else spec}"]
         return args
-    raise InputError("lights: prizma.serve takes None, a spec string, or a dict {name: spec string or None}")
+    raise _refusal("lights", "prizma.serve takes None, a spec string, or a dict {name: spec string or None}")
 
 
 class Server:
@@ -65,8 +71,9 @@ class Server:
 
     def __init__(self, command, folder):
         self._folder = folder
-        self._stderr = []
+        self._stderr = []  # the tool's stderr until it serves (guarded by _lock)
         self._started = False
+        self._lock = _threading.Lock()
         self.url = None
         self.port = None
         self._proc = _subprocess.Popen(command, stdin=_subprocess.DEVNULL, stdout=_subprocess.PIPE,
@@ -75,23 +82,30 @@ class Server:
         self._reader.start()
         line = self._proc.stdout.readline().strip()  # the URL, once the page can be opened
         m = _re.fullmatch(r"http://[^/]*:(\d+)/#token=[0-9a-f]+", line)
-        if not m:
-            code = self._proc.wait()
+        if not m:  # the tool refused (its stdout closed as it ended), or said something unexpected
+            try:
+                code = self._proc.wait(timeout=_STOP_SECONDS)
+            except _subprocess.TimeoutExpired:
+                self._proc.kill()
+                code = self._proc.wait()
             self._reader.join(timeout=_STOP_SECONDS)
             self._remove_folder()
-            raise _error_from_tool(code, "".join(self._stderr))
+            raise _error_from_tool(code, "".join(self._stderr) or line)
         self.url, self.port = line, int(m[1])
-        self._started = True
+        with self._lock:  # what it said before serving (a --bind warning) is shown, as the tool shows it
+            _sys.stderr.write("".join(self._stderr))
+            self._started = True
         _running.add(self)
 
     def _relay_stderr(self):
         """Reads the tool's stderr all along (a full pipe would block it): kept for the start's error
         message, and shown once serving (warnings, -v lines), as the tool shows them."""
         for line in self._proc.stderr:
-            if self._started:
-                _sys.stderr.write(line)
-            else:
-                self._stderr.append(line)
+            with self._lock:
+                if self._started:
+                    _sys.stderr.write(line)
+                else:
+                    self._stderr.append(line)
 
     def _remove_folder(self):
         if self._folder is not None:
@@ -151,9 +165,8 @@ def serve(image, path_of, write, port=0, bind="127.0.0.1", save_dir=None, lights
     if not tool:
         raise RuntimeFailure("prizma.serve: prizma-relight not found (installed with the module in bin/, "
                              "or built beside it): install the tools (scripts/install)")
-    port = int(port)
-    if not 0 <= port <= 65535:
-        raise InputError(f"port: must be within 0 … 65535 (got {port})")
+    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        raise _refusal("port", f"must be an integer within 0 … 65535 (got {port!r})")
     options = ["--serve", "--port", str(port), "--bind", str(bind),
                "--save-dir", path_of(save_dir if save_dir is not None else _os.getcwd(), "save_dir")]
     options += _tool_arguments(lights, exposure, display)

@@ -6,6 +6,10 @@
 // Errors: spectral::InputError → prizma.InputError (a ValueError, with .input and .reason),
 // spectral::RuntimeError and other std::exception → prizma.RuntimeFailure (a RuntimeError); what()
 // is the message, the one line the tools print after "<program>: error: ".
+//
+// Past 600 lines on purpose: the conversions every binding shares (image_from_py, light_from,
+// relight_session) live here beside the short calls that are only a conversion; calls with more to
+// them have their own files (render_call.cpp: the render thread; show_call.cpp: PNG, the server).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

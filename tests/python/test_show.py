@@ -148,10 +148,24 @@ def test_serve_errors_are_the_tools(tiny_exr, tmp_path, monkeypatch):
     assert code == 2 and str(e.value) == want
     with pytest.raises(prizma.InputError, match=r'^--light side: '):
         prizma.serve(prizma.read(tiny_exr), lights={"side": "D66"})
+    for lights in ((np.array([400.0, 700.0]), np.array([1.0, 1.0])), {"side": (np.array([400.0]), np.array([1.0]))}):
+        with pytest.raises(prizma.InputError, match=r'^lights(\["side"\])?: prizma.serve takes '):
+            prizma.serve(tiny_exr, lights=lights)
+    for port in (-1, 65536, "80", 1.5):
+        with pytest.raises(prizma.InputError, match=r"^port: must be an integer within 0 … 65535"):
+            prizma.serve(tiny_exr, port=port)
     assert private_folders(tmp_path, "prizma-serve-") == []  # the refused image's file is gone too
     with prizma.serve(tiny_exr, save_dir=tmp_path) as first:
         with pytest.raises(prizma.InputError, match="--port"):
             prizma.serve(tiny_exr, port=first.port, save_dir=tmp_path)
+
+
+def test_serve_shows_the_tools_warnings(tiny_exr, tmp_path, capsys):
+    """What the tool says on stderr before it serves (a bind that is not loopback) reaches the user."""
+    with prizma.serve(tiny_exr, bind="0.0.0.0", save_dir=tmp_path) as server:
+        assert server.url.startswith(f"http://0.0.0.0:{server.port}/#token=")
+        err = capsys.readouterr().err
+    assert "prizma-relight: warning: --bind 0.0.0.0 is not a loopback address" in err, err
 
 
 def test_serve_stops_when_python_exits(tiny_exr, tmp_path):
