@@ -10,8 +10,10 @@ private temporary folder (mode 0700; the file 0600), removed when the server sto
 """
 
 import atexit as _atexit
+import codecs as _codecs
 import os as _os
 import re as _re
+import selectors as _selectors
 import shutil as _shutil
 import signal as _signal
 import subprocess as _subprocess
@@ -71,16 +73,16 @@ class Server:
 
     def __init__(self, command, folder):
         self._folder = folder
-        self._stderr = []  # the tool's stderr until it serves (guarded by _lock)
-        self._started = False
-        self._lock = _threading.Lock()
+        self._reader = None  # the thread that shows the tool's stderr while it serves
         self.url = None
         self.port = None
+        # Unbuffered bytes: both pipes are read through select until the URL line arrives, so what
+        # the tool wrote on stderr before its URL (a --bind warning) is read, and shown, before
+        # serve() returns; a pipe the tool fills before serving never blocks it.
         self._proc = _subprocess.Popen(command, stdin=_subprocess.DEVNULL, stdout=_subprocess.PIPE,
-                                       stderr=_subprocess.PIPE, text=True)
-        self._reader = _threading.Thread(target=self._relay_stderr, daemon=True)
-        self._reader.start()
-        line = self._proc.stdout.readline().strip()  # the URL, once the page can be opened
+                                       stderr=_subprocess.PIPE, bufsize=0)
+        out, err = self._read_until_url()
+        line = out.decode(errors="replace").strip()
         m = _re.fullmatch(r"http://[^/]*:(\d+)/#token=[0-9a-f]+", line)
         if not m:  # the tool refused (its stdout closed as it ended), or said something unexpected
             try:
@@ -88,24 +90,53 @@ class Server:
             except _subprocess.TimeoutExpired:
                 self._proc.kill()
                 code = self._proc.wait()
-            self._reader.join(timeout=_STOP_SECONDS)
+            err += self._proc.stderr.read()
+            self._proc.stdout.close()
+            self._proc.stderr.close()
             self._remove_folder()
-            raise _error_from_tool(code, "".join(self._stderr) or line)
+            raise _error_from_tool(code, err.decode(errors="replace") or line)
         self.url, self.port = line, int(m[1])
-        with self._lock:  # what it said before serving (a --bind warning) is shown, as the tool shows it
-            _sys.stderr.write("".join(self._stderr))
-            self._started = True
+        _sys.stderr.write(err.decode(errors="replace"))  # shown as the tool shows it, before the URL
+        self._reader = _threading.Thread(target=self._relay_stderr, daemon=True)
+        self._reader.start()
         _running.add(self)
 
+    def _read_until_url(self):
+        """The tool's stdout up to its first line (the URL; less when it ended) and all it wrote on
+        stderr until then: the tool writes its warnings before the URL, so they are in the pipe by
+        the time the URL is, and are drained here without waiting."""
+        out, err = b"", b""
+        fds = {self._proc.stdout.fileno(): "out", self._proc.stderr.fileno(): "err"}
+        with _selectors.DefaultSelector() as sel:
+            for fd in fds:
+                sel.register(fd, _selectors.EVENT_READ)
+            while b"\n" not in out and sel.get_map():
+                for key, _ in sel.select():
+                    chunk = _os.read(key.fd, 65536)
+                    if not chunk:
+                        sel.unregister(key.fd)
+                    elif fds[key.fd] == "out":
+                        out += chunk
+                    else:
+                        err += chunk
+            err_fd = self._proc.stderr.fileno()
+            while err_fd in sel.get_map() and sel.select(timeout=0):  # what is already there
+                chunk = _os.read(err_fd, 65536)
+                if not chunk:
+                    sel.unregister(err_fd)
+                err += chunk
+        return out.split(b"\n", 1)[0], err
+
     def _relay_stderr(self):
-        """Reads the tool's stderr all along (a full pipe would block it): kept for the start's error
-        message, and shown once serving (warnings, -v lines), as the tool shows them."""
-        for line in self._proc.stderr:
-            with self._lock:
-                if self._started:
-                    _sys.stderr.write(line)
-                else:
-                    self._stderr.append(line)
+        """Reads the tool's stderr for as long as it serves (a full pipe would block it) and shows
+        it (warnings, refusals), as the tool shows them."""
+        fd = self._proc.stderr.fileno()
+        text = _codecs.getincrementaldecoder("utf-8")(errors="replace")  # a character split by read()
+        while True:
+            chunk = _os.read(fd, 65536)
+            if not chunk:
+                break
+            _sys.stderr.write(text.decode(chunk))
 
     def _remove_folder(self):
         if self._folder is not None:
@@ -127,8 +158,11 @@ class Server:
             except _subprocess.TimeoutExpired:
                 self._proc.kill()
                 self._proc.wait()
-        self._reader.join(timeout=_STOP_SECONDS)
+        if self._reader is not None:
+            self._reader.join(timeout=_STOP_SECONDS)
         self._proc.stdout.close()
+        if self._reader is None or not self._reader.is_alive():
+            self._proc.stderr.close()
         self._remove_folder()
         _running.discard(self)
         return self._proc.returncode
