@@ -3,6 +3,7 @@ display, through IPython's own formatter), and prizma.serve runs the tool's live
 memory, from a private temporary file removed when it stops (docs/python.md, "Showing an image")."""
 import json
 import os
+import shutil
 import stat
 import subprocess
 import sys
@@ -126,6 +127,48 @@ def test_serve_an_image_in_memory(tiny_exr, tmp_path, capsys):
     with pytest.raises(urllib.error.URLError):
         urllib.request.urlopen(base + "/", timeout=10)
     assert server.stop() == 0  # a second stop does nothing
+
+
+def api(method, url, headers):
+    """The status and JSON body of a request to the page's API with these headers."""
+    req = urllib.request.Request(url, data=b"" if method == "POST" else None, method=method, headers=headers)
+    try:
+        with urllib.request.urlopen(req, timeout=60) as r:
+            return r.status, json.loads(r.read())
+    except urllib.error.HTTPError as e:
+        return e.code, json.loads(e.read())
+
+
+def test_serve_keeps_the_servers_safety_rules(tiny_exr, tmp_path):
+    """prizma.serve is prizma-relight --serve (issue 21): every API call needs the run's secret and
+    the page's own origin, and Save never replaces the served file (a file served from save_dir)."""
+    served = tmp_path / "served.exr"
+    shutil.copyfile(tiny_exr, served)
+    before = served.read_bytes()
+    keep = tmp_path / "keep.png"
+    keep.write_bytes(b"not to be replaced by another page")
+    with prizma.serve(served, save_dir=tmp_path) as server:
+        base, _, token = server.url.partition("/#token=")
+        own = {TOKEN_HEADER: token, "Origin": base, "Sec-Fetch-Site": "same-origin"}
+        for why, headers in {
+            "no secret": {"Origin": base},
+            "a wrong secret": {TOKEN_HEADER: "0" * 32, "Origin": base},
+            "another origin": {TOKEN_HEADER: token, "Origin": "http://localhost:8000"},
+            "another site": {TOKEN_HEADER: token, "Sec-Fetch-Site": "cross-site"},
+        }.items():
+            for name in ("new.png", "keep.png", "served.exr"):
+                status, body = api("POST", f"{base}/api/save?file={name}", headers)
+                assert status == 403, (why, name, status, body)
+            assert api("GET", base + "/api/info", headers)[0] == 403, why
+        assert api("GET", base + "/api/info", own)[0] == 200
+        status, body = api("POST", f"{base}/api/save?file=served.exr", own)
+        assert status == 400 and "is the file being served; Save never replaces it" in body["error"], body
+        status, body = api("POST", f"{base}/api/save?file=saved.png", own)
+        assert status == 200 and body["file"] == "saved.png", body
+    assert served.read_bytes() == before
+    assert keep.read_bytes() == b"not to be replaced by another page"
+    assert (tmp_path / "saved.png").read_bytes().startswith(PNG_SIGNATURE)
+    assert not (tmp_path / "new.png").exists()
 
 
 def test_serve_starts_where_the_cli_starts(tiny_exr, tmp_path, capsys):
