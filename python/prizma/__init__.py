@@ -16,10 +16,13 @@ import numpy as _np
 
 from . import _prizma
 from ._prizma import InputError, RuntimeFailure
+from ._serve import Server
+from . import _serve
 
 __all__ = [
     "Image", "InputError", "RuntimeFailure", "read", "write", "checksum", "relight", "spectrum", "xyz",
     "lab", "delta_e2000", "named_spectra", "render", "metamer", "design_light", "version", "data_dir",
+    "serve", "Server",
 ]
 
 __version__ = _prizma.version()
@@ -160,6 +163,18 @@ class Image:
     @property
     def width(self):
         return next(iter(self.lights.values())).shape[1] if self.lights else 0
+
+    def png(self, lights=None, exposure=0.0, cmf="1931-2", display="sRGB", adapt=False, absolute=False, config=""):
+        """The PNG ``prizma-relight FILE -o x.png`` writes for these settings (:func:`relight`'s), as
+        bytes: the same writer (OpenColorIO display, ICC profile, prizma:* metadata), through a private
+        temporary folder removed before it returns."""
+        return _prizma.relight_png(self._native(), lights, float(exposure), str(cmf), str(display), bool(adapt),
+                                   bool(absolute), _path(config, "config"))
+
+    def _repr_png_(self):
+        """Jupyter's (IPython's) rich display: the image under its default lights, :meth:`png`. None
+        (no picture) for an image without lights."""
+        return self.png() if self.lights else None
 
     def __repr__(self):
         e = self.bin_edges_nm
@@ -335,3 +350,23 @@ def design_light(albedo_a, albedo_b, goal="reveal", reference="D65", primaries=(
     delta_e (under the light), delta_e_reference."""
     return _prizma.design_light(albedo_a, albedo_b, str(goal), reference, list(primaries), str(cmf), bins,
                                 float(max_power_ratio))
+
+
+def serve(image, port=0, bind="127.0.0.1", save_dir=None, lights=None, exposure=0.0, display="sRGB"):
+    """Opens the live relighting page for an image: runs ``prizma-relight FILE --serve`` (the tool
+    installed with this module) and prints the page's URL with its secret token, as the tool does.
+
+    Args:
+        image: an :class:`Image` (written to ``image.exr`` in a private temporary folder, mode 0600,
+            removed when the server stops) or the path of a spectral EXR.
+        port: 0 for a free port; bind: the address to listen on (--bind).
+        save_dir: where the page's Save writes (--save-dir); default the current folder.
+        lights, exposure, display: the page's starting state (--light, --exposure, --display);
+            lights as spec strings: one for every layer, or {name: spec or None for off}.
+
+    Returns a :class:`Server`: ``url``, ``port``, ``stop()``; a context manager. Errors are the tool's
+    (InputError for a bad file, option or a port in use). The server stops at ``stop()``, at the end
+    of a ``with`` block, when the object is collected, or when the interpreter exits.
+    """
+    return _serve.serve(image, _path, write, port=port, bind=bind, save_dir=save_dir, lights=lights,
+                        exposure=exposure, display=display)

@@ -6,6 +6,10 @@
 // Errors: spectral::InputError → prizma.InputError (a ValueError, with .input and .reason),
 // spectral::RuntimeError and other std::exception → prizma.RuntimeFailure (a RuntimeError); what()
 // is the message, the one line the tools print after "<program>: error: ".
+//
+// Past 600 lines on purpose: the conversions every binding shares (image_from_py, light_from,
+// relight_session) live here beside the short calls that are only a conversion; calls with more to
+// them have their own files (render_call.cpp: the render thread; show_call.cpp: PNG, the server).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -345,12 +349,14 @@ relight::LightSpec light_from(const py::handle& value, const std::string& input)
   return light;
 }
 
-// lights: None (the file's defaults), one light for every layer (light_from: a spec string or a
-// (wavelengths_nm, values) pair), or {name: light} (light_from, None for off).
-py::array_t<float> relight_image(const py::object& source, const py::object& lights, double exposure_ev,
-                                 const std::string& cmf, const std::optional<std::string>& display,
-                                 const std::optional<std::string>& colour_space, bool adapt, bool absolute,
-                                 const std::string& config) {
+// A session with prizma.relight's arguments applied. lights: None (the file's defaults), one light
+// for every layer (light_from: a spec string or a (wavelengths_nm, values) pair), or {name: light}
+// (light_from, None for off).
+std::unique_ptr<relight::RelightSession> relight_session(const py::object& source, const py::object& lights,
+                                                         double exposure_ev, const std::string& cmf,
+                                                         const std::optional<std::string>& display,
+                                                         const std::optional<std::string>& colour_space, bool adapt,
+                                                         bool absolute, const std::string& config) {
   std::unique_ptr<relight::RelightSession> session = open_session(source);
   relight::RelightSettings s = session->settings();
   if (py::isinstance<py::dict>(lights)) {
@@ -376,7 +382,15 @@ py::array_t<float> relight_image(const py::object& source, const py::object& lig
   if (display) s.output.display.display = *display;
   if (colour_space) s.output.display.colour_space = *colour_space;
   session->apply(s);
+  return session;
+}
 
+py::array_t<float> relight_image(const py::object& source, const py::object& lights, double exposure_ev,
+                                 const std::string& cmf, const std::optional<std::string>& display,
+                                 const std::optional<std::string>& colour_space, bool adapt, bool absolute,
+                                 const std::string& config) {
+  const std::unique_ptr<relight::RelightSession> session =
+      relight_session(source, lights, exposure_ev, cmf, display, colour_space, adapt, absolute, config);
   const int w = session->image().width, h = session->image().height;
   std::vector<float> pixels;
   {
@@ -610,5 +624,14 @@ PYBIND11_MODULE(_prizma, m) {
   m.def("render", &prizma::python::render_scene, py::arg("scene"), py::arg("scene_is_json"), py::arg("base_dir"), py::arg("samples"),
         py::arg("threads"), py::arg("seed"), py::arg("width"), py::arg("height"), py::arg("bins"), py::arg("variance"),
         py::arg("samples_per_pass"), py::arg("progress"));
+  m.def("relight_png",
+        [](const py::object& source, const py::object& lights, double exposure, const std::string& cmf,
+           const std::string& display, bool adapt, bool absolute, const std::string& config) {
+          return prizma::python::relight_png(
+              *relight_session(source, lights, exposure, cmf, display, std::nullopt, adapt, absolute, config));
+        },
+        py::arg("source"), py::arg("lights"), py::arg("exposure"), py::arg("cmf"), py::arg("display"), py::arg("adapt"),
+        py::arg("absolute"), py::arg("config"));
+  m.def("relight_tool_path", &prizma::python::relight_tool_path);
   prizma::python::register_exit_hook();
 }

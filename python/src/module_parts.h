@@ -10,6 +10,10 @@
 
 #include "prizma/spectral/spectral_exr.h"
 
+namespace prizma::relight {
+class RelightSession;
+}
+
 namespace prizma::python {
 
 namespace py = pybind11;
@@ -37,5 +41,11 @@ py::dict render_scene(const std::string& scene, bool scene_is_json, const std::s
                       const py::object& samples, const py::object& threads, const py::object& seed,
                       const py::object& width, const py::object& height, const std::optional<std::string>& bins,
                       bool variance, const py::object& samples_per_pass, const py::object& progress);
+
+// show_call.cpp: the PNG prizma-relight writes for the session's current settings, as bytes
+// (Image._repr_png_); and the prizma-relight executable prizma.serve runs (the installed tree's, else
+// the build tree's; empty when there is none).
+py::bytes relight_png(relight::RelightSession& session);
+std::string relight_tool_path();
 
 }  // namespace prizma::python

@@ -10,11 +10,22 @@ set(_docs_run ${PRIZMA_SYSTEM_PYTHON3} ${PRIZMA_E2E_DIR}/docs/run-doc)
 add_test(NAME docs.install COMMAND ${_docs_run} install --build ${CMAKE_BINARY_DIR} --work ${_docs_work})
 set_tests_properties(docs.install PROPERTIES FIXTURES_SETUP docs_installed LABELS docs TIMEOUT 120
                      RESOURCE_LOCK docs_work)
-add_test(NAME docs.user-guide COMMAND ${_docs_run} run --doc ${_docs_dir}/user-guide.md --work ${_docs_work})
+add_test(NAME docs.user-guide COMMAND ${_docs_run} run --doc ${_docs_dir}/user-guide.md --work ${_docs_work} --other-home)
 add_test(NAME docs.metamerism COMMAND ${_docs_run} run --doc ${_docs_dir}/metamerism.md --work ${_docs_work} --data-link)
 add_test(NAME docs.relight COMMAND ${_docs_run} run --doc ${_docs_dir}/relight.md --work ${_docs_work} --data-link)
 set_tests_properties(docs.user-guide docs.metamerism docs.relight PROPERTIES FIXTURES_REQUIRED docs_installed
                      LABELS docs TIMEOUT 300)
+# python.md's ```python blocks, as one session with the installed module (run-doc --python), where
+# this tree builds the module: python/ is configured after tests/, so the test is added at the end of
+# the configure (a deferred call in the top directory), when the module's target is known.
+function(prizma_add_docs_python_test)
+  if(TARGET prizma_python)
+    add_test(NAME docs.python COMMAND ${ARGN})
+    set_tests_properties(docs.python PROPERTIES FIXTURES_REQUIRED docs_installed LABELS "docs;python" TIMEOUT 300)
+  endif()
+endfunction()
+cmake_language(EVAL CODE "cmake_language(DEFER DIRECTORY [[${PROJECT_SOURCE_DIR}]] CALL prizma_add_docs_python_test
+  ${_docs_run} run --doc [[${_docs_dir}/python.md]] --work [[${_docs_work}]] --python)")
 # Every sentence of the docs about how an image looks carries a colour claim (<!-- colour: … -->),
 # checked against the image the page shows (docs/images); the run pages check theirs against what
 # their blocks wrote (check_docs.py). tests/e2e/docs/colour_claims.py.

@@ -153,9 +153,31 @@ def relight(run, out):
           (m.group(1) if m else "no line"))
 
 
+def python(run, out):
+    """python.md's session (run-doc --python: its blocks' stdout in out/python.txt)."""
+    for f in ("cube.exr", "dye.exr", "cube_side_A.png"):
+        claim(os.path.isfile(os.path.join(run, f)), "the examples wrote " + f)
+    with open(os.path.join(out, "python.txt"), encoding="utf-8") as f:
+        lines = f.read().splitlines()
+    want = "<prizma.Image 32×32, 12 bins 400–700 nm, lights ['side', 'back', 'sky']>"
+    claim(want in lines, "print(image) prints " + want)
+    claim("[[0 4]]" in lines, "print(image.reradiation_pairs) prints [[0 4]]")
+    claim(repr(b"\x89PNG\r\n\x1a\n") in lines, "Image.png() gives PNG bytes")
+    if os.path.isfile(os.path.join(run, "cube_side_A.png")):
+        px, spec = pixels(os.path.join(run, "cube_side_A.png"))
+        claim((spec.width, spec.height, spec.nchannels) == (32, 32, 3) and px.max() > 0.1,
+              "cube_side_A.png is a 32×32 RGB picture, not black")
+    urls = [l for l in lines if re.fullmatch(r"http://127\.0\.0\.1:\d+/#token=[0-9a-f]{32}", l)]
+    claim(len(urls) == 2, "prizma.serve printed the page's URL with its token, once per server (%d)" % len(urls))
+    claim("200" in lines, "the page answered 200")
+    tmp = os.path.join(os.path.dirname(run), "tmp")  # the session's TMPDIR (run-doc --python)
+    claim(os.path.isdir(tmp) and os.listdir(tmp) == [],
+          "png() and serve() left nothing in TMPDIR (%s)" % (os.listdir(tmp) if os.path.isdir(tmp) else "none"))
+
+
 def main():
     page, run, out = sys.argv[1:4]
-    {"user-guide": user_guide, "metamerism": metamerism, "relight": relight}[page](run, out)
+    {"user-guide": user_guide, "metamerism": metamerism, "relight": relight, "python": python}[page](run, out)
     if len(sys.argv) > 4:
         results = colour_claims.Results()
         docs_dir = os.path.dirname(os.path.abspath(sys.argv[4]))

@@ -104,12 +104,15 @@ def check_completion(prefix, work, env):
         pane.tmux("new-session", "-d", "-x", "120", "-y", "30", "-c", work, "bash", "--noprofile", "--rcfile", rc, "-i")
         pane.wait_for(r"(?m)^\$")
         for keys, want, what in (("prizma-render --wav\t", r"prizma-render --wavelength-sampling ", "an option name"),
-                                 ("spec\t", r"--wavelength-sampling spectral-tracking ", "an option's value"),
+                                 ("spectral-t\t", r"--wavelength-sampling spectral-tracking ", "an option's value"),
                                  ("scene_\t", r"spectral-tracking scene_a\.json", "a file name")):
             pane.tmux("send-keys", "-l", keys)
             screen = pane.wait_for(want)
             claim(re.search(want, screen) is not None, "bash completes %s: %r → %s" % (what, keys, screen.strip().split("\n")[-1]))
         pane.tmux("send-keys", "C-c")
+        # Keys sent while bash is still handling the interrupt are thrown away with the line: type
+        # only once the fresh prompt is on screen (under load this took longer than the keys).
+        pane.wait_for(r"\^C\n\$ *\n")
         pane.tmux("send-keys", "-l", "prizma-relight com\t")
         screen = pane.wait_for(r"prizma-relight compress ")
         claim("prizma-relight compress " in screen, "bash completes a subcommand: %r" % screen.strip().split("\n")[-1])

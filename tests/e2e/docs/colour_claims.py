@@ -307,7 +307,9 @@ def lint(page, results):
     for n, para in paragraphs(text):
         if "<!-- colour:" in para:
             continue
-        stripped = NOT_A_CLAIM.sub(" ", re.sub(r"`[^`]*`", " ", re.sub(r"<!--.*?-->", " ", para, flags=re.S)))
+        # Blanks made one space: a phrase that is no claim ("orange sphere") may break across lines.
+        text_only = " ".join(re.sub(r"`[^`]*`", " ", re.sub(r"<!--.*?-->", " ", para, flags=re.S)).split())
+        stripped = NOT_A_CLAIM.sub(" ", text_only)
         # Per sentence: a hue word, or grey / white / black with a verb of seeing in the same sentence.
         found = None
         for sentence in re.split(r"(?<=[.;:!?])\s+|\|", stripped):
