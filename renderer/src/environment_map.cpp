@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -19,7 +20,6 @@ using spectral::InputError;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Environment images: at most 2^25 pixels (8192 × 4096), and at most this many decoded bytes per
 // byte of file, so that a tiny file claiming a huge image is refused before anything is allocated.
 constexpr long long kMaxEnvironmentPixels = 1LL << 25;
@@ -59,7 +59,7 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> values,
   }
   if (!(peak > 0.0)) throw InputError(input, "every pixel is 0 (the light would send nothing)");
   m_constant = std::all_of(m_values.begin(), m_values.end(), [&](float v) { return v == m_values.front(); });
-  const double r = rotation_deg * kPi / 180.0;
+  const double r = rotation_deg * std::numbers::pi / 180.0;
   m_cos_rot = std::cos(r);
   m_sin_rot = std::sin(r);
 
@@ -69,7 +69,7 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> values,
   for (int y = 0; y < height; ++y) {
     double* c = m_col_cdf.data() + static_cast<std::size_t>(y) * (width + 1);
     for (int x = 0; x < width; ++x) c[x + 1] = c[x] + m_values[static_cast<std::size_t>(y) * width + x];
-    const double sin_theta = std::sin(kPi * (y + 0.5) / height);
+    const double sin_theta = std::sin(std::numbers::pi * (y + 0.5) / height);
     m_row_cdf[y + 1] = m_row_cdf[y] + c[width] * sin_theta;
   }
   m_integral = m_row_cdf[height] / (static_cast<double>(width) * height);
@@ -114,12 +114,12 @@ void EnvironmentMap::to_uv(const Eigen::Vector3d& d, double& u, double& v) const
   // Scene → map space: rotate by −rotation about +y.
   const double x = m_cos_rot * d.x() - m_sin_rot * d.z();
   const double z = m_sin_rot * d.x() + m_cos_rot * d.z();
-  v = std::acos(std::clamp(d.y(), -1.0, 1.0)) / kPi;
-  u = std::atan2(x, -z) / (2.0 * kPi) + 0.5;
+  v = std::acos(std::clamp(d.y(), -1.0, 1.0)) / std::numbers::pi;
+  u = std::atan2(x, -z) / (2.0 * std::numbers::pi) + 0.5;
 }
 
 Eigen::Vector3d EnvironmentMap::from_uv(double u, double v) const {
-  const double theta = kPi * v, phi = 2.0 * kPi * (u - 0.5);
+  const double theta = std::numbers::pi * v, phi = 2.0 * std::numbers::pi * (u - 0.5);
   const double st = std::sin(theta);
   const double x = st * std::sin(phi), y = std::cos(theta), z = -st * std::cos(phi);
   // Map → scene space: rotate by +rotation about +y.
@@ -153,22 +153,22 @@ double EnvironmentMap::sample(double u0, double u1, Eigen::Vector3d& dir, double
   const double u = (static_cast<double>(x) + fx) / m_width, v = (static_cast<double>(y) + fy) / m_height;
   dir = from_uv(u, v);
   radiance = m_values[y * static_cast<std::size_t>(m_width) + x];
-  const double sin_theta = std::sin(kPi * v);
+  const double sin_theta = std::sin(std::numbers::pi * v);
   if (!(sin_theta > 0.0)) return 0.0;
   // p(u, v) = L sin θ_y / ∫∫ L sin θ_y du dv; dω = 2π² sin θ du dv.
-  const double sin_row = std::sin(kPi * (static_cast<double>(y) + 0.5) / m_height);
+  const double sin_row = std::sin(std::numbers::pi * (static_cast<double>(y) + 0.5) / m_height);
   const double p_uv = radiance * sin_row / m_integral;
-  return p_uv / (2.0 * kPi * kPi * sin_theta);
+  return p_uv / (2.0 * std::numbers::pi * std::numbers::pi * sin_theta);
 }
 
 double EnvironmentMap::pdf(const Eigen::Vector3d& dir) const {
   double u, v;
   to_uv(dir, u, v);
-  const double sin_theta = std::sin(kPi * v);
+  const double sin_theta = std::sin(std::numbers::pi * v);
   if (!(sin_theta > 0.0)) return 0.0;
   const std::size_t px = pixel_at(u, v);
-  const double sin_row = std::sin(kPi * (static_cast<double>(px / m_width) + 0.5) / m_height);
-  return m_values[px] * sin_row / m_integral / (2.0 * kPi * kPi * sin_theta);
+  const double sin_row = std::sin(std::numbers::pi * (static_cast<double>(px / m_width) + 0.5) / m_height);
+  return m_values[px] * sin_row / m_integral / (2.0 * std::numbers::pi * std::numbers::pi * sin_theta);
 }
 
 }  // namespace prizma::render

@@ -14,7 +14,6 @@
 namespace prizma::render::testing {
 
 inline constexpr double kSe = 3.0;  // tolerance of the statistical tests in standard errors (fixed seeds)
-inline constexpr double kPi = std::numbers::pi;
 
 inline Material make_material(spectral::Spectrum albedo, spectral::Spectrum sigma_t, spectral::Spectrum g) {
   Material m;
