@@ -33,12 +33,11 @@ std::string event_probabilities_name(EventProbabilities e);
 // The inverse; InputError(input, "must be one of ...") for any other name.
 EventProbabilities parse_event_probabilities(std::string_view name, std::string_view input = "event_probabilities");
 
-// What the auto rule measured in each material's spectra (bin averages) and what it chose.
+// What the auto rule measured in a material's spectra (bin averages) and what it chose. Only what a
+// rule decides by is measured (a scheme whose rule reads another measure adds it here).
 struct MaterialEvents {
   EventProbabilities scheme = EventProbabilities::Max;
-  double extinction_ratio = 1.0;  // max_i σt,i / min_i σt,i over the bins (1 = grey; ∞ when some σt,i = 0)
-  double albedo_spread = 0.0;     // max_i α_i − min_i α_i over the bins (α = σs/σt)
-  double albedo_max = 0.0;        // max_i α_i
+  double albedo_max = 0.0;  // max_i α_i over the bins (α = σs/σt); 0 when the material has no extinction
 };
 
 // The auto rule (docs/renderer.md, "Event probabilities"), per material, since the scheme may change
@@ -47,14 +46,14 @@ struct MaterialEvents {
 // the path through the whole absorber: "max" there (average had 0.86× max's variance on the
 // metamer pair, docs/results.md). Deterministic: a function of the material's
 // spectra and the bins only. `requested` other than Auto is given to every material as it is (the
-// measurements still made).
+// measurement still made).
 inline constexpr double kAbsorbingAlbedo = 0.5;
 MaterialEvents choose_event_probabilities(EventProbabilities requested, const Material& material,
                                           const spectral::BinLayout& bins);
 std::vector<MaterialEvents> choose_event_probabilities(EventProbabilities requested,
                                                        const std::vector<Material>& materials,
                                                        const spectral::BinLayout& bins);
-// "rayleigh average (extinction ratio 9.4, albedo spread 0), sphere max (1, 0.55)": for logs.
+// "rayleigh implicit (albedo max 0.99), absorber max (albedo max 0.4)": for logs.
 std::string describe_event_probabilities(const std::vector<MaterialEvents>& choice,
                                          const std::vector<Material>& materials);
 
