@@ -28,7 +28,7 @@
 #include <utility>
 #include <vector>
 
-#include "prizma/relight/output_image.h"
+#include "prizma/spectral/output_image.h"
 #include "prizma/relight/relight_session.h"
 #include "prizma/render/render.h"
 #include "prizma/render/resume.h"
@@ -324,15 +324,15 @@ py::array_t<float> relight_image(const py::object& source, const py::object& lig
   {
     const WithoutGil released;
     session->relight();
-    const relight::XyzImage& xyz = session->xyz();
+    const spectral::XyzImage& xyz = session->xyz();
     // Exactly what write_output_image writes before quantisation: PNG/TIFF the display, clamped; EXR
     // the linear colour space, or XYZ as is (non-finite values 0 in every case).
     if (colour_space) {
-      const auto opts = relight::transform_options(relight::OutputFormat::Exr, session->settings().output);
+      const auto opts = spectral::transform_options(spectral::OutputFormat::Exr, session->settings().output);
       const spectral::DisplayTransform transform(opts);
-      pixels = relight::to_display(xyz, transform);
+      pixels = spectral::to_display(xyz, transform);
     } else if (display) {
-      pixels = relight::to_display(xyz, session->display());
+      pixels = spectral::to_display(xyz, session->display());
       for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
     } else {
       pixels = xyz.xyz;

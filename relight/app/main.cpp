@@ -18,7 +18,7 @@
 #include "prizma/relight/batch_file.h"
 #include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/interactive_shell.h"
-#include "prizma/relight/output_image.h"
+#include "prizma/spectral/output_image.h"
 #include "prizma/relight/relight_session.h"
 #include "prizma/relight/terminal_image.h"
 #include "prizma/relight/serve.h"
@@ -139,7 +139,7 @@ void save_one_line(relight::RelightSession& session, const std::string& output, 
 // transform), --colour-space when the only output is a display-encoded PNG, TIFF or JPEG. With --batch, -i or --serve either may be used there.
 void check_options_used(const CliOptions& o) {
   if (o.output.empty() || !o.batch.empty() || o.interactive || o.serve) return;
-  const bool exr = relight::output_format_for(o.output) == relight::OutputFormat::Exr;
+  const bool exr = spectral::output_format_for(o.output) == spectral::OutputFormat::Exr;
   if (exr && o.display_given && !o.show) {
     throw InputError("--display", "an EXR output is linear, not display-encoded (XYZ, or --colour-space NAME): "
                                   "--display applies to .png, .tif and .jpg outputs and --show");
@@ -163,8 +163,8 @@ int run(const CliOptions& o) {
   if (!o.serve && !o.serve_options_given.empty()) throw InputError(o.serve_options_given.front(), "only with --serve");
   if (!o.preview.empty() && !o.interactive) throw InputError("--preview", "only with -i/--interactive");
   // Cheap checks first: nothing is loaded when the output cannot be written.
-  if (!o.output.empty()) relight::check_output_path(o.output, "--output");
-  if (!o.preview.empty()) relight::check_output_path(o.preview, "--preview");
+  if (!o.output.empty()) spectral::check_output_path(o.output, "--output");
+  if (!o.preview.empty()) spectral::check_output_path(o.preview, "--preview");
   check_options_used(o);
   if (!o.ocio.empty()) spectral::require_regular_file(o.ocio, "an OCIO config");
 
@@ -184,7 +184,7 @@ int run(const CliOptions& o) {
   const relight::RelightSettings cli_settings = settings_from(o, session);
   session.apply(cli_settings);
   if (!o.output.empty()) {
-    relight::check_output_options(relight::output_format_for(o.output), session.settings().output);
+    spectral::check_output_options(spectral::output_format_for(o.output), session.settings().output);
   }
   if (o.verbose) {
     const auto& s = session.settings();
@@ -232,8 +232,8 @@ int run(const CliOptions& o) {
   }
   outputs.commit();
   if (o.show && !o.interactive) {
-    const relight::XyzImage& img = session.xyz();
-    const std::vector<float> rgb = relight::to_display(img, session.display());
+    const spectral::XyzImage& img = session.xyz();
+    const std::vector<float> rgb = spectral::to_display(img, session.display());
     if (::isatty(STDOUT_FILENO)) {  // sixel, kitty or half blocks, sized to the window
       relight::draw_terminal_image(std::cout, rgb, img.width, img.height,
                                    relight::detect_image_protocol(STDIN_FILENO, STDOUT_FILENO),

@@ -8,7 +8,7 @@
 #include <iterator>
 #include <set>
 
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
@@ -127,11 +127,11 @@ std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSess
     out.settings = defaults;
     apply_keys(entry, where, session, base_dir, out.settings);
     // Validate now so that a bad entry stops the batch before anything is written.
-    check_output_path(out.file, where + ".file");
-    RelightMatrix check(session.image().bins, out.settings.lights, out.settings.relight);
-    const OutputFormat format = output_format_for(out.file, where + ".file");
+    spectral::check_output_path(out.file, where + ".file");
+    spectral::RelightMatrix check(session.image().bins, out.settings.lights, out.settings.relight);
+    const spectral::OutputFormat format = spectral::output_format_for(out.file, where + ".file");
     try {
-      check_output_options(format, out.settings.output);
+      spectral::check_output_options(format, out.settings.output);
     } catch (const InputError& e) {
       throw InputError(where, e.what());
     }

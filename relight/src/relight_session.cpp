@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/tool_main.h"
@@ -102,11 +102,12 @@ void RelightSession::apply(RelightSettings settings) {
                                    std::to_string(settings.lights.size()));
   }
   // Build everything first; commit only when all of it succeeded.
-  RelightMatrix matrix(m_image.bins, settings.lights, settings.relight);
+  spectral::RelightMatrix matrix(m_image.bins, settings.lights, settings.relight);
   if (settings.output.bit_depth != 8 && settings.output.bit_depth != 16) {
     throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(settings.output.bit_depth));
   }
-  if (!settings.output.display.colour_space.empty()) check_output_options(OutputFormat::Exr, settings.output);
+  if (!settings.output.display.colour_space.empty())
+    spectral::check_output_options(spectral::OutputFormat::Exr, settings.output);
 
   // The display transform is built when first needed (EXR XYZ output needs no OCIO config).
   spectral::DisplayOptions display_options = settings.output.display;
@@ -176,17 +177,17 @@ double RelightSession::relight() {
   m_xyz.height = m_image.height;
   m_xyz.xyz.resize(3 * m_image.pixel_count());
   if (!m_image.reradiation.empty() && (m_reradiation.per_light.empty() || m_reradiation.cmf != m_matrix.options().cmf))
-    m_reradiation = reradiation_weights(m_image, m_matrix.options().cmf);  // once per observer
+    m_reradiation = spectral::reradiation_weights(m_image, m_matrix.options().cmf);  // once per observer
   if (m_compressed) {
     relight_compressed_into(*m_compressed, m_matrix, m_xyz.xyz.data());
   } else {
-    relight_into(m_image, m_matrix, m_xyz.xyz.data(), m_image.reradiation.empty() ? nullptr : &m_reradiation);
+    spectral::relight_into(m_image, m_matrix, m_xyz.xyz.data(), m_image.reradiation.empty() ? nullptr : &m_reradiation);
   }
   m_dirty = false;
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-const XyzImage& RelightSession::xyz() {
+const spectral::XyzImage& RelightSession::xyz() {
   relight();
   return m_xyz;
 }
@@ -240,7 +241,7 @@ CompareResult RelightSession::compare(int x1, int y1, int x2, int y2, int radius
     throw InputError("compare", "radius must be between 0 and " + std::to_string(max_radius) + ", not " +
                                     std::to_string(radius));
   }
-  const XyzImage& img = xyz();
+  const spectral::XyzImage& img = xyz();
   // Mean XYZ over the (2r+1)² square around (cx, cy), clipped to the image (never empty: the centre
   // is inside).
   auto mean = [&](int cx, int cy) {
@@ -261,17 +262,17 @@ CompareResult RelightSession::compare(int x1, int y1, int x2, int y2, int radius
 }
 
 void RelightSession::save(const std::filesystem::path& path, const std::string& input, spectral::OutputGroup* group) {
-  write_output_image(path, xyz(), m_settings.output, metadata(), input, group);
+  spectral::write_output_image(path, xyz(), m_settings.output, metadata(), input, group);
 }
 
-ImageMetadata RelightSession::metadata() const {
+spectral::ImageMetadata RelightSession::metadata() const {
   std::vector<spectral::LightRecord> lights;
   for (std::size_t l = 0; l < m_light_names.size(); ++l) {
     lights.push_back({.name = m_light_names[l], .spectrum = m_settings.lights[l].text});
   }
   std::ostringstream exposure;
   exposure << m_settings.relight.exposure_ev;
-  ImageMetadata md = {
+  spectral::ImageMetadata md = {
       {"Software", "prizma-relight " + spectral::prizma_version()},
       {"prizma:source", m_source},
       {"prizma:lights", spectral::light_records_json(lights)},

@@ -156,7 +156,7 @@ struct RelightServer::Impl {
   std::mutex mutex;  // guards session and caches (handlers run on the pool's workers)
   std::map<std::string, std::string> display_cache;
   // Bispectral files: K per observer, computed on first use (the page's re-radiation textures).
-  std::map<spectral::Observer, ReradiationWeights> reradiation_cache;
+  std::map<spectral::Observer, spectral::ReradiationWeights> reradiation_cache;
   // Last: destroyed first, so its workers have stopped before anything their handlers use goes.
   std::unique_ptr<ConnectionPool> pool;
 
@@ -244,9 +244,10 @@ struct RelightServer::Impl {
   }
 
   // K of every light for one observer (call with the mutex held).
-  const ReradiationWeights& reradiation(spectral::Observer cmf) {
+  const spectral::ReradiationWeights& reradiation(spectral::Observer cmf) {
     auto it = reradiation_cache.find(cmf);
-    if (it == reradiation_cache.end()) it = reradiation_cache.emplace(cmf, reradiation_weights(session.image(), cmf)).first;
+    if (it == reradiation_cache.end())
+      it = reradiation_cache.emplace(cmf, spectral::reradiation_weights(session.image(), cmf)).first;
     return it->second;
   }
 
@@ -259,7 +260,7 @@ struct RelightServer::Impl {
     int n = img.bins.size();
     if (g >= groups) {
       const std::lock_guard lock(mutex);
-      const ReradiationWeights& k = reradiation(cmf);
+      const spectral::ReradiationWeights& k = reradiation(cmf);
       values = &k.per_light[static_cast<std::size_t>(l)];
       n = 3 * static_cast<int>(k.in_bins.size());
       g -= groups;
@@ -284,18 +285,18 @@ struct RelightServer::Impl {
   }
 
   json weights(const RelightSettings& s) const {
-    const RelightMatrix m(session.image().bins, s.lights, s.relight);
-    ReradiationWeights in_bins;  // only the in bins: the weights of K do not depend on K
+    const spectral::RelightMatrix m(session.image().bins, s.lights, s.relight);
+    spectral::ReradiationWeights in_bins;  // only the in bins: the weights of K do not depend on K
     in_bins.in_bins = spectral::reradiation_in_bins(session.image());
     json lights = json::array();
     for (int l = 0; l < m.light_count(); ++l) {
-      const Matrix3Xd& w = m.light(l);
+      const spectral::Matrix3Xd& w = m.light(l);
       std::vector<double> rows;  // row-major X, Y, Z rows of n weights
       for (int c = 0; c < 3; ++c)
         for (int i = 0; i < m.bin_count(); ++i) rows.push_back(w(c, i));
       json light = {{"name", session.light_names()[static_cast<std::size_t>(l)]}, {"on", !w.isZero(0.0)}, {"w", rows}};
-      // Bispectral: the weights of K (3 × 3·|in|, row-major), what relight_into uses (relight_image.h).
-      if (!session.image().reradiation.empty()) light["wr"] = reradiation_term_weights(m, in_bins, l).weights;
+      // Bispectral: the weights of K (3 × 3·|in|, row-major), what spectral::relight_into uses (relight_image.h).
+      if (!session.image().reradiation.empty()) light["wr"] = spectral::reradiation_term_weights(m, in_bins, l).weights;
       lights.push_back(std::move(light));
     }
     return {{"state", state_string(s, session)}, {"lights", lights}, {"white", vec3(m.mix_white_xyz())}};

@@ -169,9 +169,9 @@ class Shell {
   void draw(std::optional<ImageProtocol> forced) {
     if (!forced && !m_protocol) m_protocol = m_opts.detect_protocol ? m_opts.detect_protocol() : m_opts.protocol;
     const TerminalSize size = m_opts.terminal_size ? m_opts.terminal_size() : m_opts.terminal;
-    const XyzImage& img = m_session.xyz();
+    const spectral::XyzImage& img = m_session.xyz();
     m_out << std::flush;
-    draw_terminal_image(m_out, to_display(img, m_session.display()), img.width, img.height,
+    draw_terminal_image(m_out, spectral::to_display(img, m_session.display()), img.width, img.height,
                         forced ? *forced : *m_protocol, size);
   }
 

@@ -10,10 +10,10 @@
 
 #include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/light_spec.h"
-#include "prizma/relight/output_image.h"
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
-#include "prizma/relight/xyz_image.h"
+#include "prizma/spectral/output_image.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
+#include "prizma/spectral/xyz_image.h"
 #include "prizma/spectral/display.h"
 #include "prizma/spectral/spectral_exr.h"
 
@@ -22,8 +22,8 @@ namespace prizma::relight {
 // Everything that decides an output image besides the transport.
 struct RelightSettings {
   std::vector<LightSpec> lights;  // one per layer, in the image's layer order
-  RelightOptions relight;
-  OutputOptions output;
+  spectral::RelightOptions relight;
+  spectral::OutputOptions output;
 };
 
 // What `probe X Y` reports about one pixel.
@@ -84,8 +84,8 @@ class RelightSession {
   // Relights with the current settings when anything changed; returns the time it took in ms
   // (0 when nothing changed).
   double relight();
-  const XyzImage& xyz();
-  const RelightMatrix& matrix() const { return m_matrix; }
+  const spectral::XyzImage& xyz();
+  const spectral::RelightMatrix& matrix() const { return m_matrix; }
   // The display transform for the current settings (built on first use after a change; throws
   // InputError when the config or display does not exist).
   const spectral::DisplayTransform& display();
@@ -98,7 +98,7 @@ class RelightSession {
   void save(const std::filesystem::path& path, const std::string& input = "--output",
             spectral::OutputGroup* group = nullptr);
   // Attributes describing how the image was made.
-  ImageMetadata metadata() const;
+  spectral::ImageMetadata metadata() const;
   // One line per layer: "name: spec".
   std::string describe_lights() const;
 
@@ -112,11 +112,11 @@ class RelightSession {
   std::vector<LightSpec> m_default_lights;
   std::vector<std::string> m_default_errors;
   RelightSettings m_settings;
-  RelightMatrix m_matrix;
+  spectral::RelightMatrix m_matrix;
   std::unique_ptr<spectral::DisplayTransform> m_display;
   spectral::DisplayOptions m_display_options;
-  XyzImage m_xyz;
-  ReradiationWeights m_reradiation;  // bispectral images: K per observer (relight_image.h)
+  spectral::XyzImage m_xyz;
+  spectral::ReradiationWeights m_reradiation;  // bispectral images: K per observer (relight_image.h)
   std::unique_ptr<CompressedTransport> m_compressed;
   bool m_dirty = true;
 };

@@ -11,12 +11,12 @@
 #include <utility>
 #include <vector>
 
-#include "prizma/relight/xyz_image.h"
+#include "prizma/spectral/xyz_image.h"
 #include "prizma/spectral/display.h"
 #include "prizma/spectral/image_io.h"
 #include "prizma/spectral/output_group.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 
 enum class OutputFormat { Png, Tiff, Exr, Jpeg };
 
@@ -27,7 +27,7 @@ OutputFormat output_format_for(const std::filesystem::path& path, const std::str
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
 struct OutputOptions {
-  spectral::DisplayOptions display;  // display, or colour_space for linear EXR output
+  DisplayOptions display;  // display, or colour_space for linear EXR output
   int bit_depth = 8;                 // 8 or 16, PNG and TIFF only
 };
 
@@ -37,12 +37,12 @@ void check_output_path(const std::filesystem::path& path, const std::string& inp
 
 // Display-encoded RGB of an XYZ image: a copy through the transform, clamped to [0, 1] for
 // integer outputs by the caller. Non-finite values become 0.
-std::vector<float> to_display(const XyzImage& image, const spectral::DisplayTransform& display);
+std::vector<float> to_display(const XyzImage& image, const DisplayTransform& display);
 
 // The display options a format uses: PNG/TIFF/JPEG the display (colour_space cleared); EXR the linear
 // colour space, or none (XYZ written as is) when colour_space is empty.
 bool needs_transform(OutputFormat format, const OutputOptions& opts);
-spectral::DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts);
+DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts);
 
 // Checks the options a format needs (builds the transform once); throws InputError when the config,
 // display or colour space does not exist, or the bit depth is not 8 or 16.
@@ -54,7 +54,7 @@ void check_output_options(OutputFormat format, const OutputOptions& opts);
 // written as the standard parametric curve it matches (the sRGB piecewise curve, a 2.4 or 2.2
 // power; within 2e-4) or else as a 1024-entry table. Nothing when the transform is not a matrix
 // followed by one increasing curve for all channels from 0 to 1 (e.g. a 3D LUT display).
-std::optional<spectral::PictureColourSpace> display_colour_space(const spectral::DisplayTransform& transform,
+std::optional<PictureColourSpace> display_colour_space(const DisplayTransform& transform,
                                                                  const std::string& name);
 
 // Writes the image (display transform for PNG/TIFF; for EXR only when colour_space is set).
@@ -63,6 +63,6 @@ std::optional<spectral::PictureColourSpace> display_colour_space(const spectral:
 // path and OpenImageIO's message) for write failures.
 void write_output_image(const std::filesystem::path& path, const XyzImage& image, const OutputOptions& opts,
                         const ImageMetadata& metadata, const std::string& input = "--output",
-                        spectral::OutputGroup* group = nullptr);
+                        OutputGroup* group = nullptr);
 
-}  // namespace prizma::relight
+}  // namespace prizma::spectral
