@@ -43,10 +43,13 @@ DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts)
   return d;
 }
 
+void OutputOptions::validate(const std::string& bit_depth_input) const {
+  if (bit_depth != 8 && bit_depth != 16)
+    throw InputError(bit_depth_input, "must be 8 or 16 (got " + std::to_string(bit_depth) + ")");
+}
+
 void check_output_options(OutputFormat format, const OutputOptions& opts) {
-  if (opts.bit_depth != 8 && opts.bit_depth != 16) {
-    throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(opts.bit_depth));
-  }
+  opts.validate("--bit-depth");
   if (format == OutputFormat::Jpeg && opts.bit_depth != 8) {
     throw InputError("--bit-depth", "JPEG is 8-bit only (got " + std::to_string(opts.bit_depth) + "; use .png or .tif for 16)");
   }

@@ -9,6 +9,11 @@
 
 namespace prizma::spectral {
 
+void RelightOptions::validate(const std::string& exposure_input) const {
+  if (!std::isfinite(exposure_ev) || std::abs(exposure_ev) > kMaxExposureEv)
+    throw InputError(exposure_input, "must be a finite number of stops within ±64");
+}
+
 RelightMatrix::RelightMatrix(const BinLayout& bins, const std::vector<LightSpectrum>& lights,
                              const RelightOptions& opts)
     : m_bins(bins.size()), m_options(opts) {

@@ -307,9 +307,6 @@ py::array_t<float> relight_image(const py::object& source, const py::object& lig
   } else if (!lights.is_none()) {
     throw InputError("lights", "must be None, a spectrum spec for every light, or a dict {name: spec or None}");
   }
-  if (!std::isfinite(exposure_ev) || std::abs(exposure_ev) > 64.0) {
-    throw InputError("exposure", "must be a finite number of stops within ±64");
-  }
   s.relight.exposure_ev = exposure_ev;
   s.relight.cmf = spectral::parse_observer(cmf, "cmf");
   s.relight.adapt_to_d65 = adapt;
@@ -317,7 +314,7 @@ py::array_t<float> relight_image(const py::object& source, const py::object& lig
   s.output.display.config = config;
   if (display) s.output.display.display = *display;
   if (colour_space) s.output.display.colour_space = *colour_space;
-  session->apply(s);
+  session->apply(s, {"exposure", "bit_depth"});
 
   const int w = session->image().width, h = session->image().height;
   std::vector<float> pixels;

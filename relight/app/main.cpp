@@ -80,6 +80,9 @@ const char* cmf_table(spectral::Observer obs) {
   return "";
 }
 
+// The settings as the command line names them in errors.
+const relight::RelightSettingNames kCliNames{"--exposure", "--bit-depth"};
+
 // The command line's settings on top of the file's default lights.
 relight::RelightSettings settings_from(const CliOptions& o, const relight::RelightSession& session) {
   relight::RelightSettings s = session.settings();
@@ -104,9 +107,6 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
       s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec(arg.substr(eq + 1), {"--light " + name, {}});
     }
   }
-  if (!std::isfinite(o.exposure_ev) || std::abs(o.exposure_ev) > 64.0) {
-    throw InputError("--exposure", "must be a finite number of stops within ±64");
-  }
   s.relight.exposure_ev = o.exposure_ev;
   s.relight.cmf = spectral::parse_observer(o.cmf, "--cmf");
   s.relight.adapt_to_d65 = o.adapt;
@@ -115,7 +115,7 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
   s.output.display.colour_space = o.colour_space;
   if (!o.ocio.empty()) s.output.display.config = o.ocio;
   s.output.bit_depth = o.bit_depth;
-  return s;
+  return s;  // validated by RelightSession::apply(…, kCliNames)
 }
 
 // session.save(), with what libpng prints on stderr (e.g. "libpng error: No IDATs written into
@@ -182,7 +182,7 @@ int run(const CliOptions& o) {
                               "needs the transport bins; serve the file it was made from");
   }
   const relight::RelightSettings cli_settings = settings_from(o, session);
-  session.apply(cli_settings);
+  session.apply(cli_settings, kCliNames);
   if (!o.output.empty()) {
     spectral::check_output_options(spectral::output_format_for(o.output), session.settings().output);
   }
@@ -223,7 +223,7 @@ int run(const CliOptions& o) {
   spectral::OutputGroup outputs;
   if (!batch.empty()) {
     relight::run_batch(session, batch, o.verbose ? &std::cerr : nullptr, &outputs);
-    session.apply(cli_settings);
+    session.apply(cli_settings, kCliNames);
   }
   if (!o.output.empty()) {
     const double ms = spectral::allocating("relighting", [&] { return session.relight(); });

@@ -96,16 +96,19 @@ int RelightSession::light_index(std::string_view name, const std::string& input)
   throw InputError(input, "no light \"" + std::string(name) + "\" in " + m_source + " (its lights: " + known + ")");
 }
 
-void RelightSession::apply(RelightSettings settings) {
+void RelightSettings::validate(const RelightSettingNames& names) const {
+  relight.validate(names.exposure);
+  output.validate(names.bit_depth);
+}
+
+void RelightSession::apply(RelightSettings settings, const RelightSettingNames& names) {
   if (settings.lights.size() != m_image.lights.size()) {
     throw InputError("lights", "expected " + std::to_string(m_image.lights.size()) + " lights, got " +
                                    std::to_string(settings.lights.size()));
   }
+  settings.validate(names);
   // Build everything first; commit only when all of it succeeded.
   spectral::RelightMatrix matrix(m_image.bins, settings.lights, settings.relight);
-  if (settings.output.bit_depth != 8 && settings.output.bit_depth != 16) {
-    throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(settings.output.bit_depth));
-  }
   if (!settings.output.display.colour_space.empty())
     spectral::check_output_options(spectral::OutputFormat::Exr, settings.output);
 
@@ -135,9 +138,6 @@ void RelightSession::set_light(std::string_view name, std::string_view spec) {
 }
 
 void RelightSession::set_exposure(double exposure_ev) {
-  if (!std::isfinite(exposure_ev) || std::abs(exposure_ev) > 64.0) {
-    throw InputError("exposure", "must be a finite number of stops within ±64");
-  }
   RelightSettings s = m_settings;
   s.relight.exposure_ev = exposure_ev;
   apply(std::move(s));

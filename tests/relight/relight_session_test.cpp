@@ -3,7 +3,9 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cmath>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <regex>
 #include <sstream>
@@ -12,6 +14,7 @@
 #include "prizma/relight/interactive_shell.h"
 #include "prizma/spectral/relight_image.h"
 #include "prizma/relight/relight_session.h"
+#include "prizma/relight/serve_state.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
@@ -49,6 +52,41 @@ std::vector<float> read_pixels(const fs::path& path, int& channels, OIIO::ImageS
   in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data());
   if (spec_out) *spec_out = spec;
   return px;
+}
+
+// The exposure and bit-depth limits are RelightSettings::validate's alone (issue 22): every front end
+// refuses the same values with the same words, naming the value as its user gave it. The page's state
+// said "must be within ±64 stops", a session's bit depth "must be 8 or 16, not 12".
+TEST(RelightSettings, EveryFrontEndRefusesWithTheOneCheck) {
+  const fs::path dir = spectral::test::scratch_dir("validate");
+  RelightSession session(write_fixture(dir));
+  auto error = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const spectral::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string range = ": must be a finite number of stops within ±64";
+  EXPECT_EQ(error([&] { session.set_exposure(64.5); }), "exposure" + range);
+  EXPECT_EQ(error([&] { settings_from_state({{"exposure", "65"}}, session, session.settings()); }), "state: exposure" + range);
+  auto batch = [&](const std::string& json) {
+    std::ofstream(dir / "b.json") << json;
+    return error([&] { read_batch_file(dir / "b.json", session, session.settings()); });
+  };
+  const std::string b = (dir / "b.json").string();
+  EXPECT_EQ(batch(R"({"outputs": [{"file": "a.png", "exposure": -70}]})"), b + ": outputs[0].exposure" + range);
+  EXPECT_EQ(batch(R"({"defaults": {"exposure": 1e300}, "outputs": [{"file": "a.png"}]})"), b + ": defaults.exposure" + range);
+  EXPECT_EQ(batch(R"({"outputs": [{"file": "a.png", "bitDepth": 24}]})"), b + ": outputs[0].bitDepth: must be 8 or 16 (got 24)");
+  RelightSettings s = session.settings();
+  s.output.bit_depth = 12;
+  EXPECT_EQ(error([&] { session.apply(s, {"--exposure", "--bit-depth"}); }), "--bit-depth: must be 8 or 16 (got 12)");
+  s.output.bit_depth = 16;
+  s.relight.exposure_ev = -64.0;  // the limit itself is allowed
+  EXPECT_EQ(error([&] { session.apply(s); }), "no error");
+  s.relight.exposure_ev = std::nan("");
+  EXPECT_EQ(error([&] { s.validate({"--exposure", "--bit-depth"}); }), "--exposure" + range);
 }
 
 TEST(RelightSession, LoadsDefaultsFromPrizmaLights) {

@@ -28,7 +28,10 @@ using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
 struct OutputOptions {
   DisplayOptions display;  // display, or colour_space for linear EXR output
-  int bit_depth = 8;                 // 8 or 16, PNG and TIFF only
+  int bit_depth = 8;       // 8 or 16, PNG and TIFF only
+
+  // Throws InputError(bit_depth_input, "must be 8 or 16 (got N)") for any other bit depth.
+  void validate(const std::string& bit_depth_input = "bit depth") const;
 };
 
 // Checks, before any work, that `path` can be written: a known extension, an existing folder that
@@ -45,7 +48,8 @@ bool needs_transform(OutputFormat format, const OutputOptions& opts);
 DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts);
 
 // Checks the options a format needs (builds the transform once); throws InputError when the config,
-// display or colour space does not exist, or the bit depth is not 8 or 16.
+// display or colour space does not exist, the bit depth is not 8 or 16 (validate("--bit-depth")), or
+// a JPEG's is not 8.
 void check_output_options(OutputFormat format, const OutputOptions& opts);
 
 // The colour space a display transform encodes into, for the ICC profile of PNG/TIFF/JPEG outputs,

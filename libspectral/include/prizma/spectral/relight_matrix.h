@@ -2,6 +2,7 @@
 // RelightMatrix: per light layer the 3×n matrix taking the layer's transport bins to CIE XYZ, with
 // exposure and optional chromatic adaptation folded in, and all layers stacked side by side.
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "prizma/spectral/light_spectrum.h"
@@ -10,14 +11,22 @@
 
 namespace prizma::spectral {
 
+// The exposure every tool accepts, in stops either way: 2^64 ≈ 1.8e19, which the float weights hold
+// for any light up to kMaxLightScale (light_spectrum.h).
+constexpr double kMaxExposureEv = 64.0;
+
 struct RelightOptions {
   Observer cmf = Observer::Cie1931_2deg;
   // RelativeToWhite: a perfect white (T = 1) under each light at scale 1 has Y = 1.
   LightUnits units = LightUnits::RelativeToWhite;
-  double exposure_ev = 0.0;  // output multiplied by 2^exposure_ev
+  double exposure_ev = 0.0;  // output multiplied by 2^exposure_ev; finite, within ±kMaxExposureEv
   // Bradford adaptation from the white of the light mix (XYZ of T = 1 under all lights) to D65,
   // preserving the white's luminance. Ignored when every light is off.
   bool adapt_to_d65 = false;
+
+  // Throws InputError(exposure_input, "must be a finite number of stops within ±64") for an exposure
+  // out of range; `exposure_input` names it as the user gave it ("--exposure", "state: exposure").
+  void validate(const std::string& exposure_input = "exposure") const;
 };
 
 using Matrix3Xd = Eigen::Matrix<double, 3, Eigen::Dynamic>;

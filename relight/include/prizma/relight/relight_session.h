@@ -19,11 +19,23 @@
 
 namespace prizma::relight {
 
+// How a front end names the settings in its errors: as the user gave them ("--exposure" on the
+// command line, "batch.json: outputs[0].exposure" in a batch file, "state: exposure" from the page).
+struct RelightSettingNames {
+  std::string exposure = "exposure";
+  std::string bit_depth = "bit depth";
+};
+
 // Everything that decides an output image besides the transport.
 struct RelightSettings {
   std::vector<LightSpec> lights;  // one per layer, in the image's layer order
   spectral::RelightOptions relight;
   spectral::OutputOptions output;
+
+  // The limits every front end shares, checked here only: the exposure (finite, within ±64 stops,
+  // RelightOptions::validate) and the bit depth (8 or 16, OutputOptions::validate). Throws
+  // InputError naming the value as `names` says.
+  void validate(const RelightSettingNames& names = {}) const;
 };
 
 // What `probe X Y` reports about one pixel.
@@ -72,9 +84,9 @@ class RelightSession {
   const std::vector<LightSpec>& default_lights() const { return m_default_lights; }
 
   const RelightSettings& settings() const { return m_settings; }
-  // Replaces every setting at once; validates (builds the matrix and display) before committing,
-  // so a failure leaves the session as it was.
-  void apply(RelightSettings settings);
+  // Replaces every setting at once; validates (RelightSettings::validate with `names`, then builds the
+  // matrix and display) before committing, so a failure leaves the session as it was.
+  void apply(RelightSettings settings, const RelightSettingNames& names = {});
   // Convenience setters (same all-or-nothing rule). An empty name sets every layer.
   void set_light(std::string_view name, std::string_view spec);
   void set_exposure(double exposure_ev);
