@@ -71,13 +71,6 @@ class AtomicSink final : public mod::ByteSink {
 
 }  // namespace
 
-PictureColourSpace srgb_picture_colour_space() {
-  PictureColourSpace cs;
-  cs.name = "sRGB";
-  cs.chromaticities = {0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290};  // IEC 61966-2-1 table 1
-  return cs;  // the default curve: type 4 with the standard's parameters
-}
-
 bool image_io_module_loaded() {
   const std::lock_guard<std::mutex> lock(g_mutex);
   return g_module != nullptr;

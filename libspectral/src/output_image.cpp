@@ -7,12 +7,14 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <vector>
 
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/output_group.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/image_io.h"
+#include "prizma/spectral/light_record.h"
 
 namespace prizma::spectral {
 
@@ -41,6 +43,33 @@ DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts)
   DisplayOptions d = opts.display;
   if (format != OutputFormat::Exr) d.colour_space.clear();
   return d;
+}
+
+ImageMetadata relight_metadata(const std::string& software, const std::string& source,
+                               const std::vector<std::string>& light_names, const std::vector<LightSpectrum>& lights,
+                               const RelightOptions& relight, const OutputOptions& output, const BinLayout& bins) {
+  std::vector<LightRecord> records;
+  for (std::size_t l = 0; l < light_names.size() && l < lights.size(); ++l) {
+    LightRecord r;
+    r.name = light_names[l];
+    r.spectrum = lights[l].text;
+    records.push_back(std::move(r));
+  }
+  std::ostringstream exposure;
+  exposure << relight.exposure_ev;
+  ImageMetadata md = {
+      {"Software", software},
+      {"prizma:source", source},
+      {"prizma:lights", light_records_json(records)},
+      {"prizma:exposureEV", exposure.str()},
+      {"prizma:cmf", observer_name(relight.cmf)},
+      {"prizma:units", relight.units == LightUnits::Absolute ? "absolute" : "relative-to-white"},
+      {"prizma:adaptation", relight.adapt_to_d65 ? "bradford-to-D65" : "none"},
+      {"prizma:binEdgesNm", bins.to_string()},
+  };
+  if (!output.display.colour_space.empty()) md.emplace_back("prizma:colourSpace", output.display.colour_space);
+  md.emplace_back("prizma:display", output.display.display);
+  return md;
 }
 
 void OutputOptions::validate(const std::string& bit_depth_input) const {

@@ -7,6 +7,7 @@
 
 #include "prizma/spectral/relight_image.h"
 #include "prizma/spectral/colour.h"
+#include "prizma/spectral/default_lights.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/tool_main.h"
 
@@ -15,37 +16,6 @@ namespace prizma::relight {
 namespace {
 
 using spectral::InputError;
-
-struct DefaultLights {
-  std::vector<LightSpec> lights;
-  // Per layer: why the recorded spectrum cannot be used (empty when it can).
-  std::vector<std::string> errors;
-};
-
-// Default light per layer (spectral::default_spectrum). A recorded spectrum that does not parse here
-// (e.g. "csv:lamp.csv" rendered on another machine) does not stop the file from opening: that layer
-// gets an "off" placeholder carrying the recorded text, and relighting fails only if the user leaves
-// it in place. (The reader has checked that the records describe the layers.)
-DefaultLights read_default_lights(const spectral::SpectralImage& image, const std::vector<std::string>& names,
-                                  const std::string& source) {
-  DefaultLights out;
-  for (std::size_t l = 0; l < names.size(); ++l) {
-    const std::string spec = spectral::default_spectrum(image.info.light_records, image.lights[l].name, names.size());
-    const std::string context = source + ": prizma:lights " + names[l];
-    try {
-      out.lights.push_back(parse_light_spec(spec, {context, {}}));
-      out.errors.emplace_back();
-    } catch (const InputError& e) {
-      LightSpec placeholder;
-      placeholder.text = spec;
-      placeholder.off = true;
-      out.lights.push_back(std::move(placeholder));
-      // Keep the inner input when it is not the context (the CSV's path, say).
-      out.errors.push_back(e.input() == context ? e.reason() : e.what());
-    }
-  }
-  return out;
-}
 
 Eigen::Vector3d xyz_to_srgb_encoded(const Eigen::Vector3d& xyz) {
   const Eigen::Vector3d lin = spectral::xyz_to_linear_srgb(xyz);
@@ -77,22 +47,19 @@ RelightSession::RelightSession(spectral::SpectralImage image, std::string source
   std::vector<std::string> layer_names;
   for (const auto& layer : m_image.lights) layer_names.push_back(layer.name);
   spectral::check_light_records(m_image.info.light_records, layer_names, m_source);  // images made in memory
-  for (const auto& name : layer_names) m_light_names.push_back(name.empty() ? "T" : name);
-  DefaultLights defaults = read_default_lights(m_image, m_light_names, m_source);
-  m_default_lights = std::move(defaults.lights);
-  m_default_errors = std::move(defaults.errors);
+  m_defaults = spectral::default_lights(m_image, m_source);
   RelightSettings settings;
-  settings.lights = m_default_lights;
+  settings.lights = m_defaults.lights;
   apply(std::move(settings));
 }
 
 RelightSession::~RelightSession() = default;
 
 int RelightSession::light_index(std::string_view name, const std::string& input) const {
-  for (std::size_t l = 0; l < m_light_names.size(); ++l)
-    if (m_light_names[l] == name) return static_cast<int>(l);
+  for (std::size_t l = 0; l < light_names().size(); ++l)
+    if (light_names()[l] == name) return static_cast<int>(l);
   std::string known;
-  for (const auto& n : m_light_names) known += (known.empty() ? "" : ", ") + n;
+  for (const auto& n : light_names()) known += (known.empty() ? "" : ", ") + n;
   throw InputError(input, "no light \"" + std::string(name) + "\" in " + m_source + " (its lights: " + known + ")");
 }
 
@@ -160,12 +127,11 @@ void RelightSession::set_display(const std::string& display) {
 }
 
 void RelightSession::check_lights_usable() const {
-  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
+  // A layer whose recorded spectrum cannot be used is refused while its placeholder is in place.
+  for (std::size_t l = 0; l < m_defaults.names.size(); ++l) {
     const LightSpec& light = m_settings.lights[l];
-    if (m_default_errors[l].empty() || !light.off || light.text != m_default_lights[l].text) continue;
-    throw InputError(m_source + ": prizma:lights " + m_light_names[l],
-                     "the recorded spectrum \"" + light.text + "\" cannot be used here (" + m_default_errors[l] +
-                         "); give this light a spectrum (--light " + m_light_names[l] + "=SPEC)");
+    if (!light.off || light.text != m_defaults.lights[l].text) continue;
+    m_defaults.require_usable(l, m_source, "; give this light a spectrum (--light " + m_defaults.names[l] + "=SPEC)");
   }
 }
 
@@ -266,34 +232,17 @@ void RelightSession::save(const std::filesystem::path& path, const std::string& 
 }
 
 spectral::ImageMetadata RelightSession::metadata() const {
-  std::vector<spectral::LightRecord> lights;
-  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
-    lights.push_back({.name = m_light_names[l], .spectrum = m_settings.lights[l].text});
-  }
-  std::ostringstream exposure;
-  exposure << m_settings.relight.exposure_ev;
-  spectral::ImageMetadata md = {
-      {"Software", "prizma-relight " + spectral::prizma_version()},
-      {"prizma:source", m_source},
-      {"prizma:lights", spectral::light_records_json(lights)},
-      {"prizma:exposureEV", exposure.str()},
-      {"prizma:cmf", spectral::observer_name(m_settings.relight.cmf)},
-      {"prizma:units", m_settings.relight.units == spectral::LightUnits::Absolute ? "absolute" : "relative-to-white"},
-      {"prizma:adaptation", m_settings.relight.adapt_to_d65 ? "bradford-to-D65" : "none"},
-      {"prizma:binEdgesNm", m_image.bins.to_string()},
-  };
-  if (!m_settings.output.display.colour_space.empty()) {
-    md.emplace_back("prizma:colourSpace", m_settings.output.display.colour_space);
-  }
-  md.emplace_back("prizma:display", m_settings.output.display.display);
+  spectral::ImageMetadata md =
+      spectral::relight_metadata("prizma-relight " + spectral::prizma_version(), m_source, light_names(),
+                                 m_settings.lights, m_settings.relight, m_settings.output, m_image.bins);
   if (m_compressed) md.emplace_back("prizma:relitFrom", "spectral-basis coefficients");
   return md;
 }
 
 std::string RelightSession::describe_lights() const {
   std::string out;
-  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
-    out += m_light_names[l] + ": " + m_settings.lights[l].text + " (default " + m_default_lights[l].text + ")\n";
+  for (std::size_t l = 0; l < light_names().size(); ++l) {
+    out += light_names()[l] + ": " + m_settings.lights[l].text + " (default " + m_defaults.lights[l].text + ")\n";
   }
   return out;
 }

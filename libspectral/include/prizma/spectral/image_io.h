@@ -37,10 +37,6 @@ struct PictureColourSpace {
   std::vector<float> curve_table;
 };
 
-// sRGB as IEC 61966-2-1 defines it (Rec. 709 primaries, D65, the piecewise curve): the colour space
-// of pictures encoded without OpenColorIO (prizma-render --preview).
-PictureColourSpace srgb_picture_colour_space();
-
 struct PictureSpec {
   int width = 0;
   int height = 0;

@@ -11,6 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include "prizma/spectral/bin_layout.h"
+#include "prizma/spectral/light_spectrum.h"
+#include "prizma/spectral/relight_matrix.h"
 #include "prizma/spectral/xyz_image.h"
 #include "prizma/spectral/display.h"
 #include "prizma/spectral/image_io.h"
@@ -33,6 +36,13 @@ struct OutputOptions {
   // Throws InputError(bit_depth_input, "must be 8 or 16 (got N)") for any other bit depth.
   void validate(const std::string& bit_depth_input = "bit depth") const;
 };
+
+// What a relit image records of how it was made: Software (`software`), prizma:source (the spectral
+// EXR), prizma:lights (each layer's name and spec), the exposure, observer, units, adaptation, bin
+// edges, and the display or linear colour space.
+ImageMetadata relight_metadata(const std::string& software, const std::string& source,
+                               const std::vector<std::string>& light_names, const std::vector<LightSpectrum>& lights,
+                               const RelightOptions& relight, const OutputOptions& output, const BinLayout& bins);
 
 // Checks, before any work, that `path` can be written: a known extension, an existing folder that
 // is writable, and not a folder itself. Throws InputError (input `input`) naming the problem.

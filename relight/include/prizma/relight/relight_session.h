@@ -14,6 +14,7 @@
 #include "prizma/spectral/relight_image.h"
 #include "prizma/spectral/relight_matrix.h"
 #include "prizma/spectral/xyz_image.h"
+#include "prizma/spectral/default_lights.h"
 #include "prizma/spectral/display.h"
 #include "prizma/spectral/spectral_exr.h"
 
@@ -74,14 +75,14 @@ class RelightSession {
   const CompressedTransport* coefficients() const { return m_compressed.get(); }
   const std::string& source() const { return m_source; }
   // Layer names as users type them ("T" for an unnamed single layer).
-  const std::vector<std::string>& light_names() const { return m_light_names; }
+  const std::vector<std::string>& light_names() const { return m_defaults.names; }
   // The layer's index; throws InputError (input `input`) listing the file's lights when unknown.
   int light_index(std::string_view name, const std::string& input = "--light") const;
   // Per layer, the default light (file's prizma:lights spectrum, else D65). A recorded spectrum that
   // cannot be parsed here (a CSV left on the rendering machine) does not stop the file from opening:
   // its default is an "off" placeholder with the recorded text, and relight() throws InputError
   // naming the light until the user gives that light a spectrum.
-  const std::vector<LightSpec>& default_lights() const { return m_default_lights; }
+  const std::vector<LightSpec>& default_lights() const { return m_defaults.lights; }
 
   const RelightSettings& settings() const { return m_settings; }
   // Replaces every setting at once; validates (RelightSettings::validate with `names`, then builds the
@@ -120,9 +121,7 @@ class RelightSession {
 
   spectral::SpectralImage m_image;
   std::string m_source;
-  std::vector<std::string> m_light_names;
-  std::vector<LightSpec> m_default_lights;
-  std::vector<std::string> m_default_errors;
+  spectral::DefaultLights m_defaults;  // names, default lights and why any cannot be used (default_lights.h)
   RelightSettings m_settings;
   spectral::RelightMatrix m_matrix;
   std::unique_ptr<spectral::DisplayTransform> m_display;
