@@ -2,7 +2,9 @@
 #   X/bin/prizma-render, prizma-relight, prizma-metamer
 #   X/lib/prizma/libprizma_imageio.so, libprizma_vdb.so  the modules loaded on first use
 #   X/share/prizma/{spectra,ocio,scenes}   the data the tools read (found relative to the executable)
+#   X/share/prizma/examples/colorchecker.exr  the spectral image relight.md's examples relight
 #   X/share/doc/prizma/                    README.md and docs/ (the user guide runs against this tree)
+#   X/share/man/man1/prizma-*.1, X/share/bash-completion/completions/prizma-*  (PrizmaToolDocs.cmake)
 include(GNUInstallDirs)
 
 set(PRIZMA_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/prizma" CACHE STRING
@@ -37,7 +39,7 @@ add_dependencies(prizma-installed ${_prizma_tools})
 # The modules the tools load on first use — the image module for PNG/TIFF/JPEG (imageio/) and the
 # VDB module for OpenVDB volumes (vdb/), both installed into lib/prizma — and the Python module
 # (python/; its own install rule): all are installed, so all are built.
-foreach(module prizma_imageio prizma_vdb prizma_python)
+foreach(module prizma_imageio prizma_vdb prizma_python prizma_colorchecker_example)
   if(TARGET ${module})
     add_dependencies(prizma-installed ${module})
   endif()
@@ -45,9 +47,14 @@ endforeach()
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/spectra ${PROJECT_SOURCE_DIR}/data/ocio ${PROJECT_SOURCE_DIR}/data/scenes
         DESTINATION ${PRIZMA_INSTALL_DATADIR} COMPONENT data)
+# The example spectral image relight.md relights (written at build time: relight/CMakeLists.txt).
+install(FILES ${PRIZMA_COLORCHECKER_EXR} DESTINATION ${PRIZMA_INSTALL_DATADIR}/examples COMPONENT data)
 
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT docs)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT docs)
 
 # The Python module (`import prizma`): its own CMakeLists has its install() rule (COMPONENT python);
 # prizma-installed depends on it (above), so scripts/install builds and installs it too.
+
+# Man pages and bash completion, made from the tools' --help (cmake/PrizmaToolDocs.cmake).
+include(${CMAKE_CURRENT_LIST_DIR}/PrizmaToolDocs.cmake)

@@ -4,6 +4,8 @@
 #include <OpenImageIO/imageio.h>
 #include <lcms2.h>
 
+#include <array>
+#include <cstdint>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -127,6 +129,36 @@ std::string one_line_error(OIIO::ImageInput* in) {
   return line.empty() ? "unknown error" : line;
 }
 
+// CRC-32 of PNG chunks (ISO 3309, polynomial 0xEDB88320, as the PNG specification's annex D computes it).
+std::uint32_t png_crc(const unsigned char* data, std::size_t n, std::uint32_t crc = 0xFFFFFFFFu) {
+  for (std::size_t i = 0; i < n; ++i) {
+    crc ^= data[i];
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return crc;
+}
+
+// Inserts a cICP chunk (PNG 3rd edition, §11.3.2.6: H.273 code points, before PLTE and IDAT) right
+// after the IHDR chunk of the PNG in `sink` (libpng 1.6.39 and OpenImageIO 2.4 write none). False
+// when the bytes are not a PNG starting with IHDR or the sink fails.
+bool insert_cicp_chunk(mod::ByteSink& sink, const std::array<std::uint8_t, 4>& cicp) {
+  constexpr std::int64_t kAfterIhdr = 8 + 8 + 13 + 4;  // signature, IHDR's length and type, data, CRC
+  const std::int64_t size = sink.size();
+  if (size < kAfterIhdr) return false;
+  std::vector<unsigned char> rest(static_cast<std::size_t>(size - kAfterIhdr));
+  unsigned char head[16];
+  if (sink.read_at(head, sizeof head, 0) != sizeof head || head[1] != 'P' || head[2] != 'N' || head[3] != 'G' ||
+      std::string(reinterpret_cast<const char*>(head + 12), 4) != "IHDR" ||
+      sink.read_at(rest.data(), rest.size(), kAfterIhdr) != rest.size()) {
+    return false;
+  }
+  unsigned char chunk[4 + 4 + 4 + 4] = {0, 0, 0, 4, 'c', 'I', 'C', 'P', cicp[0], cicp[1], cicp[2], cicp[3]};
+  const std::uint32_t crc = png_crc(chunk + 4, 8) ^ 0xFFFFFFFFu;
+  for (int k = 0; k < 4; ++k) chunk[12 + k] = static_cast<unsigned char>(crc >> (24 - 8 * k));
+  return sink.write_at(chunk, sizeof chunk, kAfterIhdr) &&
+         sink.write_at(rest.data(), rest.size(), kAfterIhdr + static_cast<std::int64_t>(sizeof chunk));
+}
+
 // Formats whose OpenImageIO writer embeds an "ICCProfile" attribute in the file. Others (OpenEXR,
 // HDR, …) have no place for one: OpenEXR's writer would print "Don't know what to do with …
 // ICCProfile" and drop it.
@@ -196,10 +228,18 @@ class OiioModule final : public mod::Module {
       reason = OIIO::geterror();
       return mod::WriteStatus::UnknownFormat;
     }
+    const std::string format = image->format_name();
     if (ps.colour_space && embeds_icc_profile(*image)) {
       const std::vector<unsigned char> icc = icc_profile(*ps.colour_space, reason);
       if (icc.empty()) return mod::WriteStatus::Failed;
       spec.attribute("ICCProfile", OIIO::TypeDesc(OIIO::TypeDesc::UINT8, static_cast<int>(icc.size())), icc.data());
+      // Exif's ColorSpace: 1 is sRGB (H.273 primaries 1 and transfer 13), 0xFFFF "uncalibrated"
+      // (another space: the profile says which).
+      const auto& cicp = ps.colour_space->cicp;
+      const bool srgb = cicp && (*cicp)[0] == 1 && (*cicp)[1] == 13;
+      // Not for TIFF: OpenImageIO 2.4's TIFF writer then leaves out the ImageLength field (as it does
+      // for oiio:ColorSpace), and the file cannot be read.
+      if (format == "jpeg") spec.attribute("Exif:ColorSpace", srgb ? 1 : 0xFFFF);
     }
     if (!image->supports("ioproxy")) return mod::WriteStatus::NoIoProxy;
     const auto fail = [&](const char* what) {
@@ -214,6 +254,10 @@ class OiioModule final : public mod::Module {
       return fail("cannot write the image");
     }
     if (!image->close()) return fail("cannot finish the image");
+    if (format == "png" && ps.colour_space && ps.colour_space->cicp && !insert_cicp_chunk(sink, *ps.colour_space->cicp)) {
+      reason = "cannot add the cICP chunk";
+      return mod::WriteStatus::Failed;
+    }
     return mod::WriteStatus::Ok;
   }
 

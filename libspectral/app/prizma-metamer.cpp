@@ -289,6 +289,12 @@ int main(int argc, char** argv) {
                "blackbody:3200K, csv:file.csv, 0.5, SPEC*0.5.",
                program};
   app.set_version_flag("--version", ps::prizma_version());
+  // Examples (tests/e2e/docs/check_help.py checks that every option they use exists).
+  app.footer("Examples:\n"
+             "  prizma-metamer metamer --albedo cc:4 --match-light D65 --split-light F11 -o metamer.csv\n"
+             "  prizma-metamer light --albedo-a cc:4 --albedo-b csv:metamer.csv --hide --reference A -o hide.csv\n"
+             "  prizma-metamer weights --light D65 --bins linear:400:700:12 -o d65.csv\n"
+             "Docs: share/doc/prizma/metamerism.md; man prizma-metamer.");
   app.require_subcommand(1);
   // Global options may come before or after the subcommand (prizma-metamer weights --bins … too).
   app.fallthrough();

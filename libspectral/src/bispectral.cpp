@@ -14,7 +14,7 @@
 #include <sstream>
 
 #include "bispectral_exr.h"
-#include "float_hash.h"
+#include "exr/checksum.h"
 #include "prizma/spectral/error.h"
 #include "text_util.h"
 
@@ -24,7 +24,6 @@ namespace {
 constexpr double kSpeedOfLight_m_per_s = 299792458.0;
 constexpr float kHalfMax = 65504.0f;
 // Offset basis of the bispectral values (the diagonal's cbf29ce484222325 rotated by 16 bits).
-constexpr std::uint64_t kFnvBasisReradiation = 0x2325cbf29ce48422ULL;
 
 double unit_factor(const std::string& prefix) {
   static const std::map<std::string, double> kFactors = {
@@ -47,7 +46,7 @@ double to_nm(const std::string& name, std::string number, const std::string& pre
   return nm;
 }
 
-std::uint64_t hash_values(const float* v, std::size_t n) { return detail::hash_float_bits(v, n, kFnvBasisReradiation); }
+std::uint64_t hash_values(const float* v, std::size_t n) { return exr::layer_hash(exr::LayerKind::Bispectral, v, n); }
 
 std::string pair_text(const SpectralImage& image, const BinPair& pr) {
   std::ostringstream os;
@@ -173,6 +172,38 @@ bool parse_reradiation_channel(const std::string& name, const std::string& path,
   return true;
 }
 
+// The top level of a bispectral file, for readers of the published layout (JCGT 2021; its reference
+// library reads a re-radiation matrix only when it holds every pair with λin < λout, and no other):
+// the lights' sum (at `sum`, pairs as image.reradiation) for every pair in < out, and 0 where the
+// image holds none (one shared row of zeros, y stride 0: no memory per pixel, PIZ stores almost nothing
+// of it; OpenEXR 3.1 does not take an x stride of 0). Pairs with λin > λout (an absorption and an emission spectrum that overlap: light absorbed
+// in one bin re-emitted in a shorter one, as Prizma's model of a dye allows) have no place in that
+// layout: they are in the light layers only, which Prizma reads.
+void add_published_pairs(const SpectralImage& image, const char* sum, Imf::PixelType type, Imf::Header& header,
+                         Imf::FrameBuffer& fb, ReradiationBuffers& keep) {
+  const std::size_t np = image.reradiation.size();
+  const std::size_t elem = type == Imf::HALF ? sizeof(half) : sizeof(float);
+  const std::size_t x_stride = elem * np;
+  const std::size_t y_stride = x_stride * static_cast<std::size_t>(image.width);
+  const auto row = static_cast<std::size_t>(image.width);
+  const char* zero = type == Imf::HALF ? reinterpret_cast<const char*>(keep.halves.emplace_back(row, half(0.0f)).data())
+                                       : reinterpret_cast<const char*>(keep.floats.emplace_back(row, 0.0f).data());
+  const int n = image.bins.size();
+  for (int in = 0; in < n; ++in) {
+    for (int out = in + 1; out < n; ++out) {
+      const auto held = std::find(image.reradiation.begin(), image.reradiation.end(), BinPair{in, out});
+      const std::string name = reradiation_channel_name(image.bins.centre_nm(in), image.bins.centre_nm(out), "");
+      header.channels().insert(name, Imf::Channel(type));
+      if (held == image.reradiation.end()) {
+        fb.insert(name, Imf::Slice(type, const_cast<char*>(zero), elem, 0));
+      } else {
+        const auto k = static_cast<std::size_t>(held - image.reradiation.begin());
+        fb.insert(name, Imf::Slice(type, const_cast<char*>(sum + elem * k), x_stride, y_stride));
+      }
+    }
+  }
+}
+
 std::uint64_t add_reradiation_for_write(const SpectralImage& image, bool multi, bool half_out, Imf::Header& header,
                                         Imf::FrameBuffer& fb, ReradiationBuffers& keep, const std::string& path) {
   check_reradiation_layout(image, path);
@@ -192,6 +223,7 @@ std::uint64_t add_reradiation_for_write(const SpectralImage& image, bool multi, 
     }
   }
   // The layers to write: each light (prefix) when multi, plus the sum at top level; else top level.
+  // (Prizma writes every bispectral file with named layers: exr::has_named_layers.)
   std::vector<std::pair<std::string, const std::vector<float>*>> layers;
   if (multi) {
     auto& sum = keep.floats.emplace_back(count, 0.0f);
@@ -228,6 +260,10 @@ std::uint64_t add_reradiation_for_write(const SpectralImage& image, bool multi, 
       base = reinterpret_cast<const char*>(hb.data());
     } else if (!summed) {
       checksum += hash_values(values->data(), count);
+    }
+    if (summed) {
+      add_published_pairs(image, base, type, header, fb, keep);
+      continue;
     }
     for (std::size_t k = 0; k < np; ++k) {
       const BinPair& pr = image.reradiation[k];

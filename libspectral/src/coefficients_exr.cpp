@@ -17,7 +17,7 @@
 #include <sstream>
 
 #include "prizma/spectral/error.h"
-#include "float_hash.h"
+#include "exr/checksum.h"
 
 namespace prizma::spectral {
 
@@ -38,8 +38,6 @@ constexpr const char* kAttrInfo = "prizma:coefficients";
 constexpr const char* kAttrBasisPrefix = "prizma:basis.";
 constexpr int kMaxK = 1024;  // at most one coefficient per bin
 // Offset bases of the coefficients (pixel-major, k contiguous) and of the basis vectors (vector-major).
-constexpr std::uint64_t kFnvBasisCoefficients = 0x9ce484222325cbf2ULL;
-constexpr std::uint64_t kFnvBasisVectors = 0x484222325cbf29ceULL;
 
 // Refuses coefficients that half cannot hold (|v| rounds past 65504).
 void check_half_range(const std::vector<float>& v, std::size_t k, std::size_t width, const std::string& what,
@@ -115,8 +113,8 @@ std::uint64_t add_coefficients_for_write(const SpectralImage& image, bool multi,
       fb.insert(name, Imf::Slice(Imf::HALF, const_cast<char*>(base + sizeof(half) * j), x_stride, y_stride));
     }
     header.insert(kAttrBasisPrefix + light.name, Imf::FloatVectorAttribute(Imf::FloatVector(c.basis.begin(), c.basis.end())));
-    sum += hash_float_bits(rounded.data(), rounded.size(), kFnvBasisCoefficients);
-    sum += hash_float_bits(c.basis.data(), c.basis.size(), kFnvBasisVectors);
+    sum += exr::layer_hash(exr::LayerKind::Coefficients, rounded.data(), rounded.size());
+    sum += exr::layer_hash(exr::LayerKind::Basis, c.basis.data(), c.basis.size());
     nlohmann::json errors = nlohmann::json::array();
     for (const BasisError& e : c.errors) errors.push_back({{"light", e.light}, {"percentile", e.percentile}, {"max", e.max}});
     lights.push_back({{"name", light.name}, {"k", c.k}, {"deltaE00", errors}});
@@ -237,8 +235,8 @@ std::uint64_t coefficients_checksum(const SpectralImage& image) {
   std::uint64_t sum = 0;
   for (const TransportLayer& light : image.lights) {
     if (light.coefficients.k == 0) continue;
-    sum += hash_float_bits(light.coefficients.values.data(), light.coefficients.values.size(), kFnvBasisCoefficients);
-    sum += hash_float_bits(light.coefficients.basis.data(), light.coefficients.basis.size(), kFnvBasisVectors);
+    sum += exr::layer_hash(exr::LayerKind::Coefficients, light.coefficients.values.data(), light.coefficients.values.size());
+    sum += exr::layer_hash(exr::LayerKind::Basis, light.coefficients.basis.data(), light.coefficients.basis.size());
   }
   return sum;
 }

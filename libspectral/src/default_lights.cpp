@@ -21,6 +21,11 @@ DefaultLights default_lights(const SpectralImage& image, const std::string& sour
       LightSpectrum placeholder;
       placeholder.text = spec;
       placeholder.off = true;
+      try {
+        placeholder.scale = light_spec_scale(spec, {context, {}});
+      } catch (const InputError&) {
+        placeholder.scale = 1.0;
+      }
       out.lights.push_back(std::move(placeholder));
       // Keep the inner input when it is not the context (the CSV's path, say).
       out.errors.push_back(e.input() == context ? e.reason() : e.what());

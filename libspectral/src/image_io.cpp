@@ -3,6 +3,7 @@
 
 #include <dlfcn.h>
 
+#include <cmath>
 #include <filesystem>
 #include <mutex>
 
@@ -70,6 +71,34 @@ class AtomicSink final : public mod::ByteSink {
 };
 
 }  // namespace
+
+std::optional<std::array<std::uint8_t, 4>> cicp_code_points(const PictureColourSpace& cs) {
+  // ITU-T H.273 (2016) table 2, colour primaries: xy of red, green, blue and white.
+  struct Primaries {
+    std::uint8_t code;
+    std::array<double, 8> xy;
+  };
+  static constexpr Primaries kPrimaries[] = {
+      {1, {0.640, 0.330, 0.300, 0.600, 0.150, 0.060, 0.3127, 0.3290}},    // BT.709, sRGB
+      {9, {0.708, 0.292, 0.170, 0.797, 0.131, 0.046, 0.3127, 0.3290}},    // BT.2020, BT.2100
+      {12, {0.680, 0.320, 0.265, 0.690, 0.150, 0.060, 0.3127, 0.3290}}};  // SMPTE EG 432-1 (P3-D65)
+  std::optional<std::uint8_t> primaries;
+  for (const Primaries& p : kPrimaries) {
+    bool close = true;
+    for (std::size_t i = 0; i < 8; ++i) close = close && std::abs(cs.chromaticities[i] - p.xy[i]) <= 0.002;
+    if (close) primaries = p.code;
+  }
+  // Table 3, transfer characteristics, for the curves display_colour_space writes exactly.
+  std::optional<std::uint8_t> transfer;
+  if (cs.curve_table.empty()) {
+    const auto& g = cs.curve_parameters;
+    if (cs.curve_type == 4 && std::abs(g[0] - 2.4) < 1e-9 && std::abs(g[4] - 0.04045) < 1e-9) transfer = 13;  // sRGB
+    if (cs.curve_type == 1 && std::abs(g[0] - 2.2) < 1e-9) transfer = 4;  // "assumed display gamma 2.2"
+    if (cs.curve_type == 1 && std::abs(g[0] - 2.4) < 1e-9) transfer = 1;  // BT.709 / BT.2020 with BT.1886
+  }
+  if (!primaries || !transfer) return std::nullopt;
+  return std::array<std::uint8_t, 4>{*primaries, *transfer, 0, 1};
+}
 
 bool image_io_module_loaded() {
   const std::lock_guard<std::mutex> lock(g_mutex);

@@ -114,9 +114,16 @@ std::string light_records_json(const std::vector<LightRecord>& records) {
   return arr.dump();
 }
 
+LightRecord light_record(std::string name, std::string spectrum) {
+  LightRecord r;
+  r.name = std::move(name);
+  r.spectrum = std::move(spectrum);
+  return r;
+}
+
 std::vector<LightRecord> light_records_for(const std::vector<std::string>& layer_names) {
   std::vector<LightRecord> out;
-  for (const auto& n : layer_names) out.push_back(LightRecord{.name = n});
+  for (const auto& n : layer_names) out.push_back(light_record(n));
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "prizma/spectral/output_image.h"
 
 #include <Eigen/Dense>
+#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -49,12 +50,8 @@ ImageMetadata relight_metadata(const std::string& software, const std::string& s
                                const std::vector<std::string>& light_names, const std::vector<LightSpectrum>& lights,
                                const RelightOptions& relight, const OutputOptions& output, const BinLayout& bins) {
   std::vector<LightRecord> records;
-  for (std::size_t l = 0; l < light_names.size() && l < lights.size(); ++l) {
-    LightRecord r;
-    r.name = light_names[l];
-    r.spectrum = lights[l].text;
-    records.push_back(std::move(r));
-  }
+  for (std::size_t l = 0; l < light_names.size() && l < lights.size(); ++l)
+    records.push_back(light_record(light_names[l], lights[l].text));
   std::ostringstream exposure;
   exposure << relight.exposure_ev;
   ImageMetadata md = {
@@ -112,7 +109,8 @@ std::optional<std::array<double, 8>> chromaticities_of(const Eigen::Matrix3d& xy
   return out;
 }
 
-// The EXR "chromaticities" (red, green, blue, white xy) of an EXR output: XYZ's own for XYZ; for a
+// The EXR "chromaticities" (red, green, blue, white xy) of an EXR output: XYZ's own for XYZ (R, G, B
+// hold X, Y, Z: red (1, 0), green (0, 1), blue (0, 0), white (⅓, ⅓), equal energy); for a
 // linear colour space those that take its RGB back to the image's XYZ (the OCIO transform's matrix M,
 // found from the XYZ unit vectors). Nothing for a colour space that is not linear.
 std::optional<std::array<float, 8>> exr_chromaticities(const OutputOptions& opts) {
@@ -201,11 +199,12 @@ std::optional<PictureColourSpace> display_colour_space(const DisplayTransform& t
     if (worst < 2e-4) {
       cs.curve_type = c.type;
       cs.curve_parameters = c.params;
+      cs.cicp = spectral::cicp_code_points(cs);
       return cs;
     }
   }
   cs.curve_table = std::move(decode);
-  return cs;
+  return cs;  // no cICP: H.273 codes no tabulated curve
 }
 
 void write_output_image(const fs::path& path, const XyzImage& image, const OutputOptions& opts,
@@ -234,11 +233,10 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
     for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
     spec.stored = opts.bit_depth == 16 ? PicturePixelType::UInt16 : PicturePixelType::UInt8;
   }
-  if (format == OutputFormat::Exr && opts.display.colour_space.empty()) {
-    spec.channel_names = {"X", "Y", "Z"};
-  } else {
-    spec.channel_names = {"R", "G", "B"};
-  }
+  // R, G, B in every format: an XYZ EXR holds X, Y, Z in them with XYZ's chromaticities (below), the
+  // convention of OpenEXR (ImfChromaticities.h, "CIE XYZ"), so every RGBA reader gets the colours
+  // (channels named X, Y, Z were read as a grey image with chromaticities applying to nothing).
+  spec.channel_names = {"R", "G", "B"};
   if (format == OutputFormat::Exr) {
     spec.attributes.emplace_back("compression", "zip");
     if (const auto chromaticities = exr_chromaticities(opts)) {
@@ -253,7 +251,20 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
     if (format == OutputFormat::Png) spec.attributes.emplace_back("oiio:ColorSpace", opts.display.display);
     if (format == OutputFormat::Jpeg) spec.attributes.emplace_back("Compression", "jpeg:95");
   }
-  for (const auto& [key, value] : metadata) spec.attributes.emplace_back(key, value);
+  if (format == OutputFormat::Tiff || format == OutputFormat::Jpeg) {
+    // TIFF and JPEG keep no text keys of their own (OpenImageIO drops "prizma:…" there): the
+    // provenance goes, as one JSON object of the same keys, into the image description (TIFF's
+    // ImageDescription tag; JPEG's comment and Exif ImageDescription), which every reader shows and
+    // OpenImageIO reads back as "ImageDescription". Software keeps its own field in both.
+    nlohmann::json provenance = nlohmann::json::object();
+    for (const auto& [key, value] : metadata) {
+      if (key == "Software") spec.attributes.emplace_back(key, value);
+      else provenance[key] = value;
+    }
+    spec.attributes.emplace_back("ImageDescription", provenance.dump());
+  } else {
+    for (const auto& [key, value] : metadata) spec.attributes.emplace_back(key, value);
+  }
 
   write_atomically(path, [&](AtomicOutput& out) {
     write_picture(out, spec, PicturePixelType::Float, pixels.data());

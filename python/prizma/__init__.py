@@ -207,9 +207,14 @@ def relight(image, lights=None, exposure=0.0, cmf="1931-2", display="sRGB", colo
 
     Args:
         image: an :class:`Image` or the path of a spectral EXR.
-        lights: None for each light's default (the spectrum recorded in the file, else D65); a
-            spectrum spec for every light ("D65", "A*0.5", "blackbody:3200K", …); or a dict
-            {light name: spec, or None for off}: lights not named keep their default.
+        lights: None for each light's default (the spectrum recorded in the file, else D65); one
+            light for every layer; or a dict {light name: light, or None for off}: lights not named
+            keep their default. A light is a spec string ("D65", "A*0.5", "blackbody:3200K", "off",
+            …), a pair (wavelengths_nm, values) of 1-D arrays (a measured SPD, normalised like any
+            light), or {"spectrum": spec or pair, "scale": s}. One light for every layer given
+            without a scale ("F11", a pair) keeps each light's recorded scale (a sky recorded as
+            "D65*0.2" gets F11*0.2; a light recorded off stays off), as ``prizma-relight --light
+            F11`` does; "F11*1" puts every light at scale 1.
         exposure: stops (EV), within ±64.
         cmf: colour matching functions: "1931-2", "1964-10", "2012-2", "2012-10".
         display: an OCIO display ("sRGB", "Display P3", "Rec.2020"): display-encoded values clamped
@@ -233,8 +238,9 @@ def relight(image, lights=None, exposure=0.0, cmf="1931-2", display="sRGB", colo
 
 def spectrum(spec, wavelengths_nm=None):
     """A spectrum from any spec string ("F11", "cc:dark-skin", "gaussian:550:20", "csv:file.csv",
-    "D65*0.5", …) → (wavelengths_nm, values), two float64 arrays: at the spectrum's own table, or at
-    ``wavelengths_nm`` when given (0 outside the table). A constant is given at 360…830 nm every 1 nm.
+    "D65*0.5", …) or pair (wavelengths_nm, values) → (wavelengths_nm, values), two float64 arrays: at
+    the spectrum's own table, or at ``wavelengths_nm`` when given (piecewise linear, 0 outside the
+    table). A constant is given at 360…830 nm every 1 nm.
     """
     at = None if wavelengths_nm is None else _np.ascontiguousarray(wavelengths_nm, dtype=_np.float64).ravel()
     return _prizma.spectrum(spec, at)

@@ -281,31 +281,89 @@ std::unique_ptr<relight::RelightSession> open_session(const py::object& source) 
   return std::make_unique<relight::RelightSession>(path);
 }
 
-// lights: None (the file's defaults), a str (every layer), or {name: spec or None (off)}.
+// A spectrum as Python gives it: a spec string, or a pair (wavelengths_nm, values) of equal-length
+// 1-D arrays (a tuple or a list: a measured table, read as a csv: file would be).
+spectral::Spectrum spectrum_from(const py::handle& spec, const std::string& input) {
+  if (py::isinstance<py::str>(spec)) return spectral::parse_spectrum(spec.cast<std::string>(), {input, {}});
+  if ((py::isinstance<py::tuple>(spec) || py::isinstance<py::list>(spec)) && py::len(spec) == 2) {
+    const auto t = spec.cast<py::sequence>();
+    DoubleArray wl = DoubleArray::ensure(t[0]), v = DoubleArray::ensure(t[1]);
+    if (!wl || !v || wl.ndim() != 1 || v.ndim() != 1 || wl.size() != v.size()) {
+      PyErr_Clear();
+      throw InputError(input, "must be a spectrum spec string or a pair (wavelengths_nm, values) of equal-length 1-D arrays");
+    }
+    return spectral::Spectrum(std::vector<double>(wl.data(), wl.data() + wl.size()),
+                              std::vector<double>(v.data(), v.data() + v.size()), input);
+  }
+  throw InputError(input, "must be a spectrum spec string or a pair (wavelengths_nm, values)");
+}
+
+// A light as Python gives it: a light spec string ("A*0.5", "off"), None (off), a spectrum pair
+// (wavelengths_nm, values) (a measured SPD, normalised as any light), or the scene file's object
+// {"spectrum": spec or pair, "scale": s}. A pair without "scale" says no scale, so given for every
+// light it keeps each light's scale (RelightSession::set_every_light), as a bare spec string does.
+relight::LightSpec light_from(const py::handle& value, const std::string& input) {
+  if (value.is_none()) return relight::parse_light_spec("off", {input, {}});
+  if (py::isinstance<py::str>(value)) return relight::parse_light_spec(value.cast<std::string>(), {input, {}});
+  if (py::isinstance<py::dict>(value)) {
+    const auto d = value.cast<py::dict>();
+    for (const auto& item : d) {
+      const std::string key = py::str(item.first);
+      if (key != "spectrum" && key != "scale") throw InputError(input + "[\"" + key + "\"]", "unknown key (known: spectrum, scale)");
+    }
+    if (!d.contains("spectrum") || d["spectrum"].is_none() || py::isinstance<py::dict>(d["spectrum"]))
+      throw InputError(input, "needs \"spectrum\": a spec string or a pair (wavelengths_nm, values)");
+    relight::LightSpec light = light_from(d["spectrum"], input + "[\"spectrum\"]");
+    if (!d.contains("scale")) return light;
+    const py::object scale_obj = d["scale"];
+    const std::string scale_input = input + "[\"scale\"]";
+    if (!(PyFloat_Check(scale_obj.ptr()) || PyLong_Check(scale_obj.ptr())) || PyBool_Check(scale_obj.ptr()))
+      throw InputError(scale_input, "must be a number (got " + std::string(py::repr(scale_obj)) + ")");
+    const double scale = scale_obj.cast<double>() * light.scale;
+    if (!std::isfinite(scale) || scale < 0.0)
+      throw InputError(scale_input, "light scale must be finite and non-negative (got " + std::string(py::repr(scale_obj)) + ")");
+    if (scale > spectral::kMaxLightScale)
+      throw InputError(scale_input, "light scale " + std::string(py::repr(py::float_(scale))) +
+                                        " is above 1e+12, the most a relight can apply without overflowing");
+    light.text += "*" + std::string(py::repr(py::float_(scale_obj.cast<double>())));
+    light.scale = scale;
+    light.scaled = true;
+    light.off = light.off || scale == 0.0;
+    return light;
+  }
+  relight::LightSpec light;
+  light.spectrum = spectrum_from(value, input);
+  const std::vector<double>& wl = light.spectrum.wavelengths_nm();
+  for (std::size_t k = 0; k < wl.size(); ++k) {  // a light, as a csv: light is (spectrum_spec.h: NonNegative)
+    if (light.spectrum.values()[k] < 0.0) {
+      throw InputError(input, "value must not be negative, got " + std::string(py::repr(py::float_(light.spectrum.values()[k]))) +
+                                  " at " + std::string(py::repr(py::float_(wl[k]))) + " nm");
+    }
+  }
+  light.text = "(wavelengths_nm, values): " + std::to_string(wl.size()) + " samples, " +
+               std::string(py::repr(py::float_(wl.front()))) + "–" + std::string(py::repr(py::float_(wl.back()))) + " nm";
+  return light;
+}
+
+// lights: None (the file's defaults), one light for every layer (light_from: a spec string or a
+// (wavelengths_nm, values) pair), or {name: light} (light_from, None for off).
 py::array_t<float> relight_image(const py::object& source, const py::object& lights, double exposure_ev,
                                  const std::string& cmf, const std::optional<std::string>& display,
                                  const std::optional<std::string>& colour_space, bool adapt, bool absolute,
                                  const std::string& config) {
   std::unique_ptr<relight::RelightSession> session = open_session(source);
   relight::RelightSettings s = session->settings();
-  if (py::isinstance<py::str>(lights)) {
-    const relight::LightSpec light = relight::parse_light_spec(lights.cast<std::string>(), {"lights", {}});
-    std::fill(s.lights.begin(), s.lights.end(), light);
-  } else if (py::isinstance<py::dict>(lights)) {
+  if (py::isinstance<py::dict>(lights)) {
     for (const auto& item : lights.cast<py::dict>()) {
       const std::string name = py::str(item.first);
       const int l = session->light_index(name, "lights");
-      const std::string input = "lights[\"" + name + "\"]";
-      if (item.second.is_none()) {
-        s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec("off", {input, {}});
-      } else if (py::isinstance<py::str>(item.second)) {
-        s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec(item.second.cast<std::string>(), {input, {}});
-      } else {
-        throw InputError(input, "must be a spectrum spec (a string such as \"D65\" or \"A*0.5\") or None (off)");
-      }
+      s.lights[static_cast<std::size_t>(l)] = light_from(item.second, "lights[\"" + name + "\"]");
     }
   } else if (!lights.is_none()) {
-    throw InputError("lights", "must be None, a spectrum spec for every light, or a dict {name: spec or None}");
+    if (!py::isinstance<py::str>(lights) && !py::isinstance<py::tuple>(lights) && !py::isinstance<py::list>(lights))
+      throw InputError("lights", "must be None, a light for every layer (a spectrum spec or a pair (wavelengths_nm, "
+                                 "values)), or a dict {name: light or None}");
+    session->set_every_light(s.lights, light_from(lights, "lights"));
   }
   s.relight.exposure_ev = exposure_ev;
   s.relight.cmf = spectral::parse_observer(cmf, "cmf");
@@ -342,21 +400,6 @@ py::array_t<float> relight_image(const py::object& source, const py::object& lig
 
 // ---------------------------------------------------------------------------------------------
 // Spectra and colour
-
-spectral::Spectrum spectrum_from(const py::object& spec, const std::string& input) {
-  if (py::isinstance<py::str>(spec)) return spectral::parse_spectrum(spec.cast<std::string>(), {input, {}});
-  if (py::isinstance<py::tuple>(spec) && py::len(spec) == 2) {
-    const auto t = spec.cast<py::tuple>();
-    DoubleArray wl = DoubleArray::ensure(t[0]), v = DoubleArray::ensure(t[1]);
-    if (!wl || !v || wl.ndim() != 1 || v.ndim() != 1 || wl.size() != v.size()) {
-      PyErr_Clear();
-      throw InputError(input, "must be a spectrum spec string or a pair (wavelengths_nm, values) of equal-length 1-D arrays");
-    }
-    return spectral::Spectrum(std::vector<double>(wl.data(), wl.data() + wl.size()),
-                              std::vector<double>(v.data(), v.data() + v.size()), input);
-  }
-  throw InputError(input, "must be a spectrum spec string or a pair (wavelengths_nm, values)");
-}
 
 std::pair<py::array_t<double>, py::array_t<double>> spectrum_values(const py::object& spec,
                                                                     const std::optional<DoubleArray>& at) {

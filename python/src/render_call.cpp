@@ -3,6 +3,7 @@
 // setting the renderer's cancellation flag when one arrives. render() then returns the passes
 // completed so far. Integer arguments are checked as the tools check their options.
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>  // Scene::warnings → a list of str
 
 #include <atomic>
 #include <charconv>
@@ -191,7 +192,9 @@ py::dict render_scene(const std::string& scene_source, bool scene_is_json, const
   s["samples_completed"] = stats.samples_completed;
   s["interrupted"] = stats.interrupted;
   s["wall_seconds"] = stats.wall_seconds;
-  s["warnings"] = scene.warnings;  // what a library noticed in an input it still read (an OpenVDB file)
+  py::list warnings;  // what a library noticed in an input it still read (an OpenVDB file)
+  for (const std::string& w : scene.warnings) warnings.append(w);
+  s["warnings"] = warnings;
   out["stats"] = s;
   return out;
 }

@@ -96,12 +96,13 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
     }
     seen.push_back(target);
   }
+  // The spectrum for every layer first (at each layer's scale: RelightSession::set_every_light),
+  // then the named layers, wherever they stand on the command line.
+  for (const std::string& arg : o.lights)
+    if (arg.find('=') == std::string::npos) session.set_every_light(s.lights, relight::parse_light_spec(arg, {"--light", {}}));
   for (const std::string& arg : o.lights) {
     const auto eq = arg.find('=');
-    if (eq == std::string::npos) {
-      const relight::LightSpec light = relight::parse_light_spec(arg, {"--light", {}});
-      std::fill(s.lights.begin(), s.lights.end(), light);
-    } else {
+    if (eq != std::string::npos) {
       const std::string name = arg.substr(0, eq);
       const int l = session.light_index(name, "--light");
       s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec(arg.substr(eq + 1), {"--light " + name, {}});
@@ -170,17 +171,13 @@ int run(const CliOptions& o) {
 
   spectral::ExrReadOptions read_options;
   read_options.verify_checksum = !o.no_verify;
-  // Spectral-basis coefficients (prizma-relight compress) are relit when present, unless --exact;
-  // the live page draws the bins on the GPU, so --serve reads them (and refuses a compact file).
-  read_options.read_coefficients = !o.exact && !o.serve;
+  // Spectral-basis coefficients (prizma-relight compress) are relit when present, unless --exact; the
+  // live page (--serve) then relights from them on the GPU too.
+  read_options.read_coefficients = !o.exact;
   read_options.allow_compact = true;
   relight::RelightSession session = spectral::allocating("reading " + o.input, [&] {
     return relight::RelightSession(spectral::read_spectral_exr(o.input, read_options), o.input, o.exact);
   });
-  if (o.serve && session.image().compact()) {
-    throw InputError(o.input, "compact file: it holds only spectral-basis coefficients, and the live page (--serve) "
-                              "needs the transport bins; serve the file it was made from");
-  }
   const relight::RelightSettings cli_settings = settings_from(o, session);
   session.apply(cli_settings, kCliNames);
   if (!o.output.empty()) {
@@ -196,6 +193,7 @@ int run(const CliOptions& o) {
               << (spectral::data_dir() / cmf_table(s.relight.cmf)).string() << ")\n"
               << "prizma-relight: OCIO config " << session.display().config_path().string() << ", "
               << session.display().description() << "\n";
+    for (const std::string& note : session.image().info.notes) std::cerr << "prizma-relight: note: " << note << "\n";
     const std::string coverage =
         spectral::cmf_coverage_note(spectral::ColorMatching::get(s.relight.cmf), session.image().bins);
     if (!coverage.empty()) std::cerr << "prizma-relight: note: " << coverage << "\n";
@@ -372,8 +370,18 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(spectral::non_empty_path());
   app.set_version_flag("--version", prizma::spectral::prizma_version());
-  app.footer("Also: prizma-relight compress IN.exr -o OUT.exr [--compact] [--max-error DE] adds spectral-basis "
-             "coefficients (prizma-relight compress --help).");
+  // Examples (tests/e2e/docs/check_help.py checks that every option they use exists).
+  app.footer("Examples:\n"
+             "  prizma-relight cs.exr -o cs.png                      (each light as the render recorded it)\n"
+             "  prizma-relight cs.exr --light side=A --light back=off --exposure 1 -o a.png\n"
+             "  prizma-relight cs.exr --light F11 --display \"Display P3\" -o p3.png   (every light F11, each at its scale)\n"
+             "  prizma-relight cs.exr --colour-space ACEScg -o acescg.exr\n"
+             "  prizma-relight cs.exr --batch outputs.json\n"
+             "  prizma-relight cs.exr -i                             (the interactive shell)\n"
+             "  prizma-relight cs.exr --serve                        (the live page in a browser)\n"
+             "Also: prizma-relight compress IN.exr -o OUT.exr [--compact] [--max-error DE] adds spectral-basis "
+             "coefficients (prizma-relight compress --help).\n"
+             "Docs: share/doc/prizma/relight.md; man prizma-relight.");
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
   o.display_given = app.count("--display") > 0;
   for (const char* name : {"--bind", "--port", "--save-dir"})

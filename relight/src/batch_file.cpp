@@ -42,8 +42,7 @@ void apply_keys(const json& obj, const std::string& where, const RelightSession&
     try {
       if (key == "lights") {
         if (value.is_string()) {
-          const LightSpec light = parse_light_spec(value.get<std::string>(), {input, base_dir});
-          std::fill(s.lights.begin(), s.lights.end(), light);
+          session.set_every_light(s.lights, parse_light_spec(value.get<std::string>(), {input, base_dir}));
         } else if (value.is_object()) {
           for (const auto& [name, spec] : value.items()) {
             if (!spec.is_string()) throw InputError(input + "." + name, "must be a spectrum spec string");

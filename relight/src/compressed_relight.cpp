@@ -71,9 +71,8 @@ AddRow add_row_for(int k) {
 // Per layer of the transport, W_l = A·M_l·B_l as float, row-major (3·k), where A is `display`
 // (XYZ → linear display RGB) or the identity; empty for lights that are off. The shape checks and the
 // "off" rule are spectral::relight_into's (spectral::light_weights, relight_image.h).
-std::vector<std::vector<float>> coefficient_weights(const CompressedTransport& transport,
-                                                    const spectral::RelightMatrix& matrix,
-                                                    const Eigen::Matrix3f* display) {
+std::vector<std::vector<float>> folded_weights(const CompressedTransport& transport, const spectral::RelightMatrix& matrix,
+                                               const Eigen::Matrix3f* display) {
   const int n = transport.bins.size();
   const int layers = static_cast<int>(transport.lights.size());
   const std::vector<spectral::LightWeights> on = spectral::light_weights(matrix, layers, n, "compressed transport");
@@ -169,10 +168,13 @@ CompressedTransport compress_transport(const spectral::SpectralImage& image, con
   return out;
 }
 
-void relight_compressed_into(const CompressedTransport& transport, const spectral::RelightMatrix& matrix,
-                             float* xyz_out) {
+std::vector<std::vector<float>> coefficient_weights(const CompressedTransport& transport, const spectral::RelightMatrix& matrix) {
+  return folded_weights(transport, matrix, nullptr);
+}
+
+void relight_compressed_into(const CompressedTransport& transport, const spectral::RelightMatrix& matrix, float* xyz_out) {
   // W_l = M_l·B_l once per light setting, float, row-major; "off" lights are skipped.
-  const std::vector<std::vector<float>> weights = coefficient_weights(transport, matrix, nullptr);
+  const std::vector<std::vector<float>> weights = coefficient_weights(transport, matrix);
   std::vector<CoeffTerm> terms;
   std::vector<AddRow> kernels;
   for (std::size_t t = 0; t < weights.size(); ++t) {
@@ -513,7 +515,7 @@ void relight_compressed_to_display8(const CompressedTransport& transport, const 
     encoder.encode(xyz.data(), pixels, rgb_out);
     return;
   }
-  const std::vector<std::vector<float>> weights = coefficient_weights(transport, matrix, &encoder.matrix());
+  const std::vector<std::vector<float>> weights = folded_weights(transport, matrix, &encoder.matrix());
   std::vector<detail::SimdCoeffLayer> terms;
   for (std::size_t t = 0; t < weights.size(); ++t) {
     if (weights[t].empty()) continue;

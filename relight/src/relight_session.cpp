@@ -92,12 +92,24 @@ void RelightSession::apply(RelightSettings settings, const RelightSettingNames& 
   m_dirty = true;
 }
 
+void RelightSession::set_every_light(std::vector<LightSpec>& lights, const LightSpec& given) const {
+  if (lights.size() != light_names().size()) {
+    throw InputError("lights", "expected " + std::to_string(light_names().size()) + " lights, got " +
+                                   std::to_string(lights.size()));
+  }
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const LightSpec& now = lights[l];
+    const bool placeholder = m_defaults.placeholder_in_place(l, now);
+    lights[l] = spectral::at_light_scale(given, placeholder || !now.off ? now.scale : 0.0);
+  }
+}
+
 void RelightSession::set_light(std::string_view name, std::string_view spec) {
   RelightSettings s = m_settings;
   const std::string input = name.empty() ? "light" : "light " + std::string(name);
   const LightSpec light = parse_light_spec(spec, {input, {}});
   if (name.empty()) {
-    std::fill(s.lights.begin(), s.lights.end(), light);
+    set_every_light(s.lights, light);
   } else {
     s.lights[static_cast<std::size_t>(light_index(name, "light"))] = light;
   }
@@ -129,8 +141,7 @@ void RelightSession::set_display(const std::string& display) {
 void RelightSession::check_lights_usable() const {
   // A layer whose recorded spectrum cannot be used is refused while its placeholder is in place.
   for (std::size_t l = 0; l < m_defaults.names.size(); ++l) {
-    const LightSpec& light = m_settings.lights[l];
-    if (!light.off || light.text != m_defaults.lights[l].text) continue;
+    if (!m_defaults.placeholder_in_place(l, m_settings.lights[l])) continue;
     m_defaults.require_usable(l, m_source, "; give this light a spectrum (--light " + m_defaults.names[l] + "=SPEC)");
   }
 }

@@ -214,26 +214,43 @@ int merge_main(int argc, char** argv) {
 
 }  // namespace
 
+int inspect_main(int argc, char** argv);  // inspect.cpp
+
 int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "merge") return merge_main(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "inspect") return inspect_main(argc, argv);
 
   CLI::App app{"Renders a spectral volume scene to a spectral OpenEXR file: per pixel, per light and per bin\n"
                "the transport under unit white light, ready for prizma-relight.\n"
                "  prizma-render SCENE.json -o OUT.exr [options]\n"
-               "  prizma-render merge a.exr b.exr ... -o all.exr",
+               "  prizma-render merge a.exr b.exr ... -o all.exr\n"
+               "  prizma-render inspect VOLUME|SCENE   (values, histogram, material ranges)",
                kProgram};
   app.set_version_flag("--version", spectral::prizma_version());
+  // Examples (tests/e2e/docs/check_help.py checks that every option they use exists).
+  app.footer("Examples:\n"
+             "  prizma-render data/scenes/cube_sphere.json -o cs.exr --spp 64 --preview cs.png\n"
+             "  prizma-render scene.json -D camera.fov_deg=30 -D lights.side.spectrum=A -o zoom.exr -q\n"
+             "  prizma-render scene.json --samples 0:128 -o a.exr    (a shard; prizma-render merge a.exr b.exr -o all.exr)\n"
+             "  prizma-render --resume part.exr --spp 256           (continue an interrupted render)\n"
+             "  prizma-render inspect head.nii.gz                   (the values, to choose material ranges)\n"
+             "Docs: share/doc/prizma/renderer.md, scene-format.md; man prizma-render.");
   Options o;
   app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own")
       ->check(spectral::non_empty_path());
   app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")")
       ->check(spectral::non_empty_path());
-  app.add_option("--spp", o.spp_text, "samples per pixel (renders samples [begin, begin + N); with --resume the total)");
-  app.add_option("--width", o.width_text, "image width in pixels");
-  app.add_option("--height", o.height_text, "image height in pixels");
-  app.add_option("--bins", o.bins, "bin layout: linear:400:700:12, exp:400:700:12:1.5, edges:400,450,500");
-  app.add_option("--seed", o.seed_text, "random seed");
-  app.add_option("--samples", o.samples, "sample range A:B of every pixel (for shards; merge them later)");
+  // --spp, --width, --height and --seed are read as text and checked as the scene's fields are (the
+  // messages name the range); their value is a whole number: INT in --help.
+  app.add_option("--spp", o.spp_text, "samples per pixel (renders samples [begin, begin + N); with --resume the total)")
+      ->type_name("INT");
+  app.add_option("--width", o.width_text, "image width in pixels")->type_name("INT");
+  app.add_option("--height", o.height_text, "image height in pixels")->type_name("INT");
+  app.add_option("--bins", o.bins, "bin layout: linear:400:700:12, exp:400:700:12:1.5, edges:400,450,500")
+      ->type_name("SPEC");
+  app.add_option("--seed", o.seed_text, "random seed")->type_name("INT");
+  app.add_option("--samples", o.samples, "sample range A:B of every pixel (for shards; merge them later)")
+      ->type_name("A:B");
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_option("--wavelength-sampling", o.wavelength_sampling,
                  "spectral-tracking (all bins per path) or single (VPT: one wavelength per path)")

@@ -1,5 +1,6 @@
-// EnvironmentMap: lat-long radiance image, its piecewise-constant 2D sampling distribution, and
-// reading it with OpenImageIO.
+// EnvironmentMap: a radiance image in one of three conventions (latitude–longitude as Prizma or
+// Mitsuba 3 lay it out, pbrt-v4's equal-area square), its piecewise-constant 2D sampling
+// distribution, and reading it with OpenImageIO.
 #include "prizma/render/environment_map.h"
 
 
@@ -9,6 +10,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "checked_picture.h"
@@ -39,12 +41,63 @@ std::size_t find_interval(const double* cdf, std::size_t n, double x) {
   return std::min(i, n - 1);
 }
 
+// Clarberg's equal-area mapping between the unit square and the sphere ("Fast Equal-Area Mapping of
+// the (Hemi)Sphere using SIMD", JGT 2008), as pbrt-v4 writes it (util/math.cpp,
+// EqualAreaSquareToSphere and EqualAreaSphereToSquare; there atan is a polynomial within 1e-6):
+// the square's centre is +z, its corners −z, its edges' midpoints the equator.
+Eigen::Vector3d equal_area_square_to_sphere(double px, double py) {
+  const double u = 2.0 * px - 1.0, v = 2.0 * py - 1.0;
+  const double up = std::abs(u), vp = std::abs(v);
+  const double signed_distance = 1.0 - (up + vp);  // from the diagonal: > 0 in the upper hemisphere
+  const double r = 1.0 - std::abs(signed_distance);
+  const double phi = (r == 0.0 ? 1.0 : (vp - up) / r + 1.0) * std::numbers::pi / 4.0;
+  const double z = std::copysign(1.0 - r * r, signed_distance);
+  const double s = r * std::sqrt(std::max(0.0, 2.0 - r * r));
+  return {std::copysign(std::cos(phi), u) * s, std::copysign(std::sin(phi), v) * s, z};
+}
+
+void equal_area_sphere_to_square(const Eigen::Vector3d& d, double& px, double& py) {
+  const double x = std::abs(d.x()), y = std::abs(d.y()), z = std::abs(d.z());
+  const double r = std::sqrt(std::max(0.0, 1.0 - z));
+  const double a = std::max(x, y), b = a == 0.0 ? 0.0 : std::min(x, y) / a;
+  double phi = std::atan(b) * 2.0 / std::numbers::pi;
+  if (x < y) phi = 1.0 - phi;
+  double v = phi * r, u = r - v;
+  if (d.z() < 0.0) {
+    std::swap(u, v);
+    u = 1.0 - u;
+    v = 1.0 - v;
+  }
+  px = 0.5 * (std::copysign(u, d.x()) + 1.0);
+  py = 0.5 * (std::copysign(v, d.y()) + 1.0);
+}
+
 }  // namespace
 
+EnvironmentConvention parse_environment_convention(const std::string& name, const std::string& input) {
+  if (name == "prizma") return EnvironmentConvention::Prizma;
+  if (name == "mitsuba") return EnvironmentConvention::Mitsuba;
+  if (name == "pbrt-equal-area") return EnvironmentConvention::PbrtEqualArea;
+  throw InputError(input, "unknown convention \"" + name + "\" (known: prizma, mitsuba, pbrt-equal-area)");
+}
+
+const char* environment_convention_name(EnvironmentConvention c) {
+  switch (c) {
+    case EnvironmentConvention::Mitsuba: return "mitsuba";
+    case EnvironmentConvention::PbrtEqualArea: return "pbrt-equal-area";
+    case EnvironmentConvention::Prizma: break;
+  }
+  return "prizma";
+}
+
 EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> values, double rotation_deg,
-                               const std::string& input)
-    : m_width(width), m_height(height), m_values(std::move(values)) {
+                               const std::string& input, EnvironmentConvention convention)
+    : m_width(width), m_height(height), m_values(std::move(values)), m_convention(convention) {
   if (width < 1 || height < 1) throw InputError(input, "image is empty");
+  if (convention == EnvironmentConvention::PbrtEqualArea && width != height) {
+    throw InputError(input, "a pbrt-equal-area map is square (got " + std::to_string(width) + "×" +
+                                std::to_string(height) + ")");
+  }
   const std::size_t n = static_cast<std::size_t>(width) * height;
   if (m_values.size() != n) throw InputError(input, "image has " + std::to_string(m_values.size()) + " values for " +
                                                         std::to_string(width) + "×" + std::to_string(height) + " pixels");
@@ -63,19 +116,19 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> values,
   m_cos_rot = std::cos(r);
   m_sin_rot = std::sin(r);
 
-  // Row marginal ∝ Σ_x L(x, y) sin θ_y and per-row conditionals ∝ L(x, y) (cumulative, in double).
+  // Row marginal ∝ Σ_x L(x, y) · row_weight(y) and per-row conditionals ∝ L(x, y) (cumulative, in double).
   m_row_cdf.assign(static_cast<std::size_t>(height) + 1, 0.0);
   m_col_cdf.assign(static_cast<std::size_t>(height) * (width + 1), 0.0);
   for (int y = 0; y < height; ++y) {
     double* c = m_col_cdf.data() + static_cast<std::size_t>(y) * (width + 1);
     for (int x = 0; x < width; ++x) c[x + 1] = c[x] + m_values[static_cast<std::size_t>(y) * width + x];
-    const double sin_theta = std::sin(std::numbers::pi * (y + 0.5) / height);
-    m_row_cdf[y + 1] = m_row_cdf[y] + c[width] * sin_theta;
+    m_row_cdf[y + 1] = m_row_cdf[y] + c[width] * row_weight(static_cast<std::size_t>(y));
   }
   m_integral = m_row_cdf[height] / (static_cast<double>(width) * height);
 }
 
-EnvironmentMap EnvironmentMap::load(const std::filesystem::path& path, double rotation_deg, const std::string& input) {
+EnvironmentMap EnvironmentMap::load(const std::filesystem::path& path, double rotation_deg, const std::string& input,
+                                    EnvironmentConvention convention) {
   const std::string file = path.string();
   CheckedPicture picture = read_picture_checked(
       path, {"an environment image", "an environment map", "image library", kMaxEnvironmentPixels, kMaxEnvironmentExpansion},
@@ -104,7 +157,7 @@ EnvironmentMap EnvironmentMap::load(const std::filesystem::path& path, double ro
     }
   }
   try {
-    return EnvironmentMap(w, h, std::move(lum), rotation_deg, input);
+    return EnvironmentMap(w, h, std::move(lum), rotation_deg, input, convention);
   } catch (const InputError& e) {
     throw InputError(input, "image " + file + ": " + e.reason());  // names the file, as the reader's errors do
   }
@@ -114,16 +167,42 @@ void EnvironmentMap::to_uv(const Eigen::Vector3d& d, double& u, double& v) const
   // Scene → map space: rotate by −rotation about +y.
   const double x = m_cos_rot * d.x() - m_sin_rot * d.z();
   const double z = m_sin_rot * d.x() + m_cos_rot * d.z();
+  if (m_convention == EnvironmentConvention::PbrtEqualArea) {
+    equal_area_sphere_to_square({x, -z, d.y()}, u, v);  // pbrt's light space: its +z is our +y
+    return;
+  }
   v = std::acos(std::clamp(d.y(), -1.0, 1.0)) / std::numbers::pi;
   u = std::atan2(x, -z) / (2.0 * std::numbers::pi) + 0.5;
+  if (m_convention == EnvironmentConvention::Mitsuba) u = u >= 0.5 ? u - 0.5 : u + 0.5;  // Mitsuba's u = 0 is −z
 }
 
 Eigen::Vector3d EnvironmentMap::from_uv(double u, double v) const {
-  const double theta = std::numbers::pi * v, phi = 2.0 * std::numbers::pi * (u - 0.5);
-  const double st = std::sin(theta);
-  const double x = st * std::sin(phi), y = std::cos(theta), z = -st * std::cos(phi);
+  double x, y, z;
+  if (m_convention == EnvironmentConvention::PbrtEqualArea) {
+    const Eigen::Vector3d w = equal_area_square_to_sphere(u, v);
+    x = w.x();
+    y = w.z();
+    z = -w.y();
+  } else {
+    const double theta = std::numbers::pi * v;
+    const double phi = 2.0 * std::numbers::pi * (m_convention == EnvironmentConvention::Mitsuba ? u : u - 0.5);
+    const double st = std::sin(theta);
+    x = st * std::sin(phi);
+    y = std::cos(theta);
+    z = -st * std::cos(phi);
+  }
   // Map → scene space: rotate by +rotation about +y.
   return {m_cos_rot * x + m_sin_rot * z, y, -m_sin_rot * x + m_cos_rot * z};
+}
+
+double EnvironmentMap::jacobian(double v) const {
+  if (m_convention == EnvironmentConvention::PbrtEqualArea) return 4.0 * std::numbers::pi;
+  return 2.0 * std::numbers::pi * std::numbers::pi * std::sin(std::numbers::pi * v);
+}
+
+double EnvironmentMap::row_weight(std::size_t y) const {
+  if (m_convention == EnvironmentConvention::PbrtEqualArea) return 1.0;
+  return std::sin(std::numbers::pi * (static_cast<double>(y) + 0.5) / m_height);
 }
 
 std::size_t EnvironmentMap::pixel_at(double u, double v) const {
@@ -153,22 +232,19 @@ double EnvironmentMap::sample(double u0, double u1, Eigen::Vector3d& dir, double
   const double u = (static_cast<double>(x) + fx) / m_width, v = (static_cast<double>(y) + fy) / m_height;
   dir = from_uv(u, v);
   radiance = m_values[y * static_cast<std::size_t>(m_width) + x];
-  const double sin_theta = std::sin(std::numbers::pi * v);
-  if (!(sin_theta > 0.0)) return 0.0;
-  // p(u, v) = L sin θ_y / ∫∫ L sin θ_y du dv; dω = 2π² sin θ du dv.
-  const double sin_row = std::sin(std::numbers::pi * (static_cast<double>(y) + 0.5) / m_height);
-  const double p_uv = radiance * sin_row / m_integral;
-  return p_uv / (2.0 * std::numbers::pi * std::numbers::pi * sin_theta);
+  const double jac = jacobian(v);
+  if (!(jac > 0.0)) return 0.0;
+  // p(u, v) = L · row weight / ∫∫ L · row weight du dv; dω = jacobian · du dv.
+  return radiance * row_weight(y) / m_integral / jac;
 }
 
 double EnvironmentMap::pdf(const Eigen::Vector3d& dir) const {
   double u, v;
   to_uv(dir, u, v);
-  const double sin_theta = std::sin(std::numbers::pi * v);
-  if (!(sin_theta > 0.0)) return 0.0;
+  const double jac = jacobian(v);
+  if (!(jac > 0.0)) return 0.0;
   const std::size_t px = pixel_at(u, v);
-  const double sin_row = std::sin(std::numbers::pi * (static_cast<double>(px / m_width) + 0.5) / m_height);
-  return m_values[px] * sin_row / m_integral / (2.0 * std::numbers::pi * std::numbers::pi * sin_theta);
+  return m_values[px] * row_weight(px / static_cast<std::size_t>(m_width)) / m_integral / jac;
 }
 
 }  // namespace prizma::render

@@ -8,8 +8,10 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -22,6 +24,7 @@
 #include "prizma/render/fluorescence.h"
 #include "prizma/render/transfer_function.h"
 #include "prizma/render/volume.h"
+#include "prizma/render/volume_inspection.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/input_file.h"
@@ -583,6 +586,33 @@ void check_light_name(const Reader& rd, const std::string& name, const std::stri
   spectral::check_exr_light_name(name, rd.input(path));
 }
 
+// An environment-map light's fields: the image, its convention and rotation (docs/scene-format.md,
+// "Environment maps"). A square image must say its convention: it is pbrt-v4's equal-area layout as
+// often as a latitude–longitude map of an unusual shape, and read as the wrong one every direction
+// is wrong.
+void read_environment_map(const Reader& rd, const json& lj, const std::string& lp, Light& l) {
+  for (const char* key : {"radius", "spot"})
+    if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to point lights only (this light is an environment map)");
+  const std::string ep = Reader::join(lp, "environment");
+  if (lj.contains("rotation_deg")) {
+    const std::string rp = Reader::join(lp, "rotation_deg");
+    l.rotation_deg = rd.number(lj.at("rotation_deg"), rp);
+    if (!(std::abs(l.rotation_deg) <= 360.0)) rd.fail(rp, "must be in [-360, 360] (got " + num(l.rotation_deg) + ")");
+  }
+  const std::string cp = Reader::join(lp, "convention");
+  std::optional<EnvironmentConvention> convention;
+  if (lj.contains("convention")) convention = parse_environment_convention(rd.string(lj.at("convention"), cp), rd.input(cp));
+  l.environment_file = rd.string(lj.at("environment"), ep);
+  l.environment_map = std::make_shared<const EnvironmentMap>(EnvironmentMap::load(
+      rd.file_path(lj.at("environment"), ep), l.rotation_deg, rd.input(ep), convention.value_or(EnvironmentConvention::Prizma)));
+  const EnvironmentMap& map = *l.environment_map;
+  if (!convention && map.width() == map.height() && map.width() > 1) {
+    rd.fail(cp, "is required for the square image " + l.environment_file + " (" + std::to_string(map.width()) + "×" +
+                    std::to_string(map.height()) + "): \"pbrt-equal-area\" for pbrt-v4's equal-area map, or " +
+                    "\"prizma\" or \"mitsuba\" for a latitude–longitude map");
+  }
+}
+
 // A point, sphere or spot light ("position") or an environment map ("environment"), with their
 // fields (docs/scene-format.md, "Point, sphere and spot lights", "Environment maps").
 void read_point_or_environment_light(const Reader& rd, const json& lj, const std::string& lp, Light& l) {
@@ -592,7 +622,8 @@ void read_point_or_environment_light(const Reader& rd, const json& lj, const std
     if (lj.contains(key)) rd.fail(Reader::join(lp, key), "does not apply to a light with " + other + " (a light has one of direction, position and environment)");
   if (point) {
     if (lj.contains("environment")) rd.fail(Reader::join(lp, "environment"), "does not apply to a light with position (a light has one of direction, position and environment)");
-    if (lj.contains("rotation_deg")) rd.fail(Reader::join(lp, "rotation_deg"), "applies to environment-map lights only (this light has a position)");
+    for (const char* key : {"rotation_deg", "convention"})
+      if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to environment-map lights only (this light has a position)");
     const std::string pp = Reader::join(lp, "position");
     const auto p = rd.vec3(lj.at("position"), pp);
     for (int a = 0; a < 3; ++a)
@@ -631,17 +662,7 @@ void read_point_or_environment_light(const Reader& rd, const json& lj, const std
     }
     return;
   }
-  for (const char* key : {"radius", "spot"})
-    if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to point lights only (this light is an environment map)");
-  const std::string ep = Reader::join(lp, "environment");
-  if (lj.contains("rotation_deg")) {
-    const std::string rp = Reader::join(lp, "rotation_deg");
-    l.rotation_deg = rd.number(lj.at("rotation_deg"), rp);
-    if (!(std::abs(l.rotation_deg) <= 360.0)) rd.fail(rp, "must be in [-360, 360] (got " + num(l.rotation_deg) + ")");
-  }
-  l.environment_file = rd.string(lj.at("environment"), ep);
-  l.environment_map = std::make_shared<const EnvironmentMap>(
-      EnvironmentMap::load(rd.file_path(lj.at("environment"), ep), l.rotation_deg, rd.input(ep)));
+  read_environment_map(rd, lj, lp, l);
 }
 
 std::vector<Light> read_lights(const Reader& rd, const json& j) {
@@ -654,7 +675,7 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
     const std::string lp = Reader::index(path, i);
     const json& lj = j[i];
     rd.expect_object(lj, lp, {"name", "direction", "spectrum", "angular_size_deg", "position", "radius", "spot",
-                              "environment", "rotation_deg"});
+                              "environment", "rotation_deg", "convention"});
     Light l;
     const std::string np = Reader::join(lp, "name");
     if (!lj.contains("name")) rd.fail(np, "is required");
@@ -681,8 +702,8 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
       }
       for (const char* key : {"radius", "spot"})
         if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to point lights only (give position, not direction)");
-      if (lj.contains("rotation_deg"))
-        rd.fail(Reader::join(lp, "rotation_deg"), "applies to environment-map lights only (give environment, not direction)");
+      for (const char* key : {"rotation_deg", "convention"})
+        if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to environment-map lights only (give environment, not direction)");
     }
     if (lj.contains("spectrum")) {
       const std::string sp = Reader::join(lp, "spectrum");
@@ -1076,6 +1097,42 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverr
   std::stringstream buffer;
   buffer << in.rdbuf();
   return scene_from_text(buffer.str(), file, path, overrides);
+}
+
+InspectedVolume load_for_inspection(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  spectral::require_regular_file(path, "a scene or volume file");
+  InspectedVolume out;
+  out.input = file;
+  std::string name = path.filename().string();
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+  const auto ends = [&](const char* e) { return name.size() >= std::strlen(e) && name.compare(name.size() - std::strlen(e), std::string::npos, e) == 0; };
+  if (ends(".json")) {
+    // The scene's volume and transfer function, read by the loader's own functions.
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    const json root = parse_json(buffer.str(), file);
+    const Reader rd(file, path.parent_path());
+    if (!root.is_object() || !root.contains("volume")) rd.fail("volume", "is required");
+    out.volume = read_volume(rd, root.at("volume"));
+    out.from_scene = true;
+    out.normalisation_given = (root.contains("normalisation") && root.at("normalisation").is_object()) ||
+                              (root.contains("normalization") && root.at("normalization").is_object());
+    out.normalisation = read_normalisation(rd, root, out.volume);
+    if (root.contains("materials")) out.transfer = read_materials(rd, root.at("materials"), out.normalisation);
+    else if (root.contains("transfer_function")) out.transfer = read_tf_image(rd, root.at("transfer_function"), out.normalisation);
+    return out;
+  }
+  // A volume file: the "volume" a scene would give for it.
+  const char* type = ends(".nii") || ends(".nii.gz") ? "nifti" : ends(".raw") ? "raw" : ends(".vdb") ? "vdb" : nullptr;
+  if (type == nullptr) {
+    throw InputError(file, "not a scene or volume file this can inspect (known: .json, .nii, .nii.gz, .raw, .vdb)");
+  }
+  const Reader rd("", std::filesystem::path());  // the path as given: the loaders' messages name it so
+  out.volume = read_volume(rd, json{{"type", type}, {"path", file}});
+  out.normalisation = auto_normalisation(out.volume);
+  return out;
 }
 
 Scene load_scene_text(const std::string& text, const std::string& input, const std::filesystem::path& base_dir,

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -96,7 +97,7 @@ std::string orient_ras(const nifti_image& nim, Volume& vol) {
   int out_of[3] = {-1, -1, -1};  // world axis → file axis
   bool flip[3] = {false, false, false};
   std::string file_axes;
-  bool oblique = false;
+  double worst_cos = 1.0;  // the cosine of the largest angle between a file axis and its nearest world axis
   for (int i = 0; i < 3; ++i) {
     if (code[i] < 1 || code[i] > 6) return std::string("NIfTI orientation: the ") + source + " is degenerate: file axes kept";
     const int w = (code[i] - 1) / 2;
@@ -106,7 +107,17 @@ std::string orient_ras(const nifti_image& nim, Volume& vol) {
     file_axes += std::string(i == 0 ? "" : " ") + "+" + "ijk"[i] + "→" + kDir[code[i] - 1];
     double len = 0.0;
     for (int r = 0; r < 3; ++r) len += static_cast<double>(m.m[r][i]) * m.m[r][i];
-    if (std::abs(m.m[w][i]) < 0.9999 * std::sqrt(len)) oblique = true;
+    if (len > 0.0) worst_cos = std::min(worst_cos, std::abs(static_cast<double>(m.m[w][i])) / std::sqrt(len));
+  }
+  // An oblique file (tilted slices) is snapped, not resampled: the anatomy comes out rotated by up to
+  // that angle, which a user must hear without asking (--verbose): a warning on every render.
+  const bool oblique = worst_cos < 0.9999;
+  if (oblique) {
+    char angle[32];
+    std::snprintf(angle, sizeof angle, "%.1f", std::acos(worst_cos) * 180.0 / std::numbers::pi);
+    vol.warnings.push_back(vol.source + ": NIfTI orientation: the " + source + " is oblique (a file axis is " + angle +
+                           "° from the nearest anatomical axis); its axes were snapped to the nearest (file " + file_axes +
+                           "), not resampled, so the volume is rotated by up to " + angle + "° from the patient's frame");
   }
   const std::array<int, 3> src = vol.dims;
   std::array<int, 3> dims{};

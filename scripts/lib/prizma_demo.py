@@ -109,13 +109,19 @@ def bins_spec(edges):
     return "edges:" + ",".join("%.6g" % e for e in edges)
 
 
+XYZ_CHROMATICITIES = (1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0 / 3.0, 1.0 / 3.0)
+
+
 def xyz_image(path):
-    pixels, names, _ = read_image(path)
-    try:
-        idx = [names.index(c) for c in ("X", "Y", "Z")]
-    except ValueError:
-        raise DemoFailure("%s: expected X, Y, Z channels (got %s)" % (path, ", ".join(names)))
-    return pixels[:, :, idx]
+    """The X, Y, Z of an XYZ EXR from prizma-relight: channels R, G, B with XYZ's chromaticities
+    (OpenEXR's convention, docs/relight.md)."""
+    pixels, names, spec = read_image(path)
+    chroma = spec.getattribute("chromaticities")
+    if names[:3] != ["R", "G", "B"] or chroma is None or \
+            not np.allclose(np.asarray(chroma, dtype=np.float64), XYZ_CHROMATICITIES, atol=1e-6):
+        raise DemoFailure("%s: expected R, G, B channels holding X, Y, Z (XYZ chromaticities); got %s, chromaticities %s"
+                          % (path, ", ".join(names), chroma))
+    return pixels[:, :, :3]
 
 
 def side_masks(total, fraction=0.5):

@@ -4,7 +4,9 @@ if(NOT TARGET prizma-relight)
   return()
 endif()
 
-add_executable(prizma_relight_make_fixture ${PRIZMA_E2E_DIR}/relight/make_fixture.cpp)
+add_executable(prizma_relight_make_fixture ${PRIZMA_E2E_DIR}/relight/make_fixture.cpp
+               ${PROJECT_SOURCE_DIR}/relight/examples/colorchecker_chart.cpp)
+target_include_directories(prizma_relight_make_fixture PRIVATE ${PROJECT_SOURCE_DIR}/relight/examples)
 target_link_libraries(prizma_relight_make_fixture PRIVATE prizma::spectral PkgConfig::OIIO)
 prizma_set_warnings(prizma_relight_make_fixture)
 
@@ -38,6 +40,10 @@ prizma_relight_e2e(light_before_input "--light|D65|scene.exr|-o|light_first.png"
 # The 2012 observers on the default 380–780 nm bins (their table starts at 390 nm): zero below it.
 prizma_relight_e2e(cmf2012_below_table "colorchecker.exr|--cmf|2012-2|--verbose|-o|cmf2012.png" MUST_EXIST cmf2012.png
   STDERR_MATCH "note: bins .* reach outside the cie2012-2 colour matching table \\(390–830 nm\\)")
+# A reflective file from the JCGT reference writer sampled every 100 nm from 400 nm: its inferred
+# first edge (350 nm) is clamped to the tables and -v says so (issue 25 item 13).
+prizma_relight_e2e(reference_writer_file "reference400.exr|--verbose|-o|reference400.png" MUST_EXIST reference400.png
+  STDERR_MATCH "note: .*reference400\\.exr: the inferred first bin edge 350 nm is outside the colour matching tables \\(360–830 nm\\): clamped to 360 nm")
 prizma_relight_e2e(batch "scene.exr|--batch|batch.json" MUST_EXIST "batch_d65.png|batch_a16.png|batch_xyz.exr")
 prizma_relight_e2e(interactive "scene.exr|-i|--preview|session_preview.png"
   STDIN ${PRIZMA_E2E_DIR}/relight/session.txt

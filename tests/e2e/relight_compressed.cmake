@@ -25,7 +25,9 @@ prizma_compressed_e2e(compact_interactive "cc_compact.exr|-i" STDIN ${PRIZMA_E2E
 # Refused, one line, exit 2, nothing written.
 prizma_compressed_e2e(compact_exact "cc_compact.exr|--exact|-o|err_compact_exact.png" EXPECT_RC 2
   ERR_REGEX "cc_compact\\.exr: compact file: .*cannot be relit exactly" MUST_NOT_EXIST err_compact_exact.png)
-prizma_compressed_e2e(compact_serve "cc_compact.exr|--serve" EXPECT_RC 2 ERR_REGEX "cc_compact\\.exr: compact file: .*live page")
+# The live page relights a compact file from its coefficients (relight.live.browser); --exact cannot.
+prizma_compressed_e2e(compact_serve_exact "cc_compact.exr|--serve|--exact" EXPECT_RC 2
+  ERR_REGEX "cc_compact\\.exr: compact file: .*cannot be relit exactly")
 prizma_compressed_e2e(compress_compact_input "compress|cc_compact.exr|-o|err_again.exr" EXPECT_RC 2
   ERR_REGEX "cc_compact\\.exr: is a compact file .*compress the file it was made from" MUST_NOT_EXIST err_again.exr)
 prizma_compressed_e2e(compress_bad_bound "compress|scene.exr|-o|err_bound.exr|--max-error|0" EXPECT_RC 2

@@ -47,6 +47,15 @@ else()
   prizma_missing_tool_test(render.e2e.preview_is_the_relight "oiiotool (Debian openimageio-tools)")
 endif()
 
+# prizma-render inspect (issue 25 item 9): the scene's volume, histogram and the voxels each material
+# takes (tiny.json: cube_sphere at 16³, haze [50, 150], core [200, 255]); a volume file; a file it
+# cannot inspect is one line, exit 2.
+prizma_render_e2e(inspect_scene "inspect|${_tiny}|--bins|4"
+  OUT_REGEX "volume +cube_sphere \\(procedural\\): 16 × 16 × 16 voxels.*histogram +4 bins over \\[100, 255\\].*haze +\\[50, 150\\] \\(normalised \\[0.196078, 0.588235\\]\\): [0-9 ]+ voxels.*core +\\[200, 255\\].*no material")
+prizma_render_e2e(inspect_volume "inspect|${PRIZMA_SOURCE_DATA_DIR}/scenes/bench_peer_64x64x64.nii.gz"
+  OUT_REGEX "NIfTI\\): 64 × 64 × 64 voxels.*voxel size +1 × 1 × 1 mm.*orientation +NIfTI orientation")
+prizma_render_e2e(inspect_unknown "inspect|${_tiny}.txt" EXPECT_RC 2 ERR_LINES 1)
+
 # A material's anisotropy is signed: a csv: table of g with negative values renders; the same table
 # as an albedo is refused, naming the file and line (issue 27; docs/spectra.md, "Signed quantities").
 prizma_render_e2e(signed_anisotropy_table "${_tiny}|-D|materials.haze.anisotropy=csv:backscatter_g.csv|-o|backscatter.exr|-q"

@@ -127,6 +127,12 @@ TEST(RelightSession, UnusableRecordedLightFailsOnlyWhenUsed) {
   session.set_light("back", "D65");
   EXPECT_NO_THROW(session.relight());
   EXPECT_FLOAT_EQ(session.xyz().xyz[1], 2.0f * y_key_only);  // both lights see T = 0.5, Y = 1 each
+  // One spectrum for every light makes it usable too, at the scale it was recorded with (×2).
+  RelightSession fresh(path);
+  fresh.set_light("", "D65");
+  EXPECT_EQ(fresh.settings().lights[1].text, "D65*2");
+  EXPECT_NO_THROW(fresh.relight());
+  EXPECT_FLOAT_EQ(fresh.xyz().xyz[1], 3.0f * y_key_only);
 }
 
 TEST(RelightSession, UnknownLightNameListsTheFilesLights) {
@@ -270,10 +276,11 @@ TEST(BatchFile, WritesEveryOutputFromOneLoad) {
     "outputs": [
       {"file": "d65.exr", "lights": {"key": "D65"}},
       {"file": "bright.exr", "lights": {"key": "D65"}, "exposure": 2},
-      {"file": "back.exr", "lights": "F11", "cmf": "1964"}
+      {"file": "back.exr", "lights": "F11", "cmf": "1964"},
+      {"file": "all1.exr", "lights": "F11*1", "cmf": "1964"}
     ]})";
   const auto outputs = read_batch_file(dir / "batch.json", session, session.settings());
-  ASSERT_EQ(outputs.size(), 3u);
+  ASSERT_EQ(outputs.size(), 4u);
   run_batch(session, outputs, nullptr);
   int ch = 0;
   const auto d65 = read_pixels(dir / "d65.exr", ch);
@@ -285,7 +292,40 @@ TEST(BatchFile, WritesEveryOutputFromOneLoad) {
   EXPECT_NEAR(d65[1], 0.5, 1e-6);            // grey under key
   EXPECT_EQ(d65[3 * 4 + 1], 0.0f);           // back is off in the defaults
   EXPECT_NEAR(bright[1], 4.0 * d65[1], 1e-6);
-  EXPECT_GT(back[3 * 4 + 1], 0.05f);         // every light F11: the right half lit
+  // "F11" for every light keeps each light's scale: back, off in the defaults, stays off; "F11*1"
+  // puts every light at scale 1 and lights the right half (relight.md, "One spectrum for every light").
+  EXPECT_EQ(back[3 * 4 + 1], 0.0f);
+  EXPECT_GT(back[1], 0.05f);
+  const auto all1 = read_pixels(dir / "all1.exr", ch);
+  EXPECT_GT(all1[3 * 4 + 1], 0.05f);
+  EXPECT_EQ(all1[1], back[1]);
+}
+
+TEST(RelightSession, OneSpectrumForEveryLightKeepsEachLightsScale) {
+  // The scale a light has (recorded, or set before) is kept by a spec without one; a spec with one is
+  // used as it is; a light that is off stays off (issue 25 item 5).
+  const fs::path dir = spectral::test::scratch_dir("every-light");
+  RelightSession session(write_fixture(dir));
+  session.set_light("key", "D65*0.25");
+  session.set_light("", "F11");
+  EXPECT_EQ(session.settings().lights[0].text, "F11*0.25");
+  EXPECT_EQ(session.settings().lights[0].scale, 0.25);
+  EXPECT_FALSE(session.settings().lights[0].off);
+  session.set_light("back", "off");
+  session.set_light("", "A");
+  EXPECT_TRUE(session.settings().lights[1].off);
+  EXPECT_EQ(session.settings().lights[1].text, "off");
+  EXPECT_EQ(session.settings().lights[0].text, "A*0.25");
+  session.set_light("", "A*2");
+  EXPECT_EQ(session.settings().lights[0].text, "A*2");
+  EXPECT_EQ(session.settings().lights[1].text, "A*2");
+  EXPECT_FALSE(session.settings().lights[1].off);
+  // The weights follow the texts: "F11" at key's 0.25 is a quarter of F11 at scale 1.
+  session.set_light("key", "D65*0.25");
+  session.set_light("", "F11");
+  const Eigen::MatrixXd quarter = session.matrix().light(0);
+  session.set_light("key", "F11");
+  EXPECT_TRUE(quarter.isApprox(0.25 * session.matrix().light(0), 1e-12));
 }
 
 TEST(BatchFile, BadEntryStopsTheBatchBeforeAnythingIsWritten) {

@@ -456,6 +456,53 @@ TEST(InteractiveShell, ShowDrawsWithTheChosenProtocolAndShowEveryAfterChanges) {
   EXPECT_EQ(text.find("\u2580"), std::string::npos);
 }
 
+// Issue 25 item 17: inside tmux a sixel or kitty image that tmux would not pass on is refused with
+// what to do; kitty goes through tmux's passthrough once it is allowed.
+TEST(TerminalImage, RouteInsideTmux) {
+  for (ImageProtocol p : {ImageProtocol::Blocks, ImageProtocol::Sixel, ImageProtocol::Kitty}) {
+    const ImageRoute outside = image_route(p, TmuxFacts{});
+    EXPECT_TRUE(outside.shown && !outside.tmux_passthrough && outside.why.empty()) << image_protocol_name(p);
+  }
+  const TmuxFacts plain_tmux{.inside = true};
+  EXPECT_TRUE(image_route(ImageProtocol::Blocks, plain_tmux).shown);
+  const ImageRoute sixel = image_route(ImageProtocol::Sixel, plain_tmux);
+  EXPECT_FALSE(sixel.shown);
+  EXPECT_NE(sixel.why.find("--enable-sixel"), std::string::npos) << sixel.why;
+  EXPECT_TRUE(image_route(ImageProtocol::Sixel, TmuxFacts{.inside = true, .sixel = true}).shown);
+  const ImageRoute kitty = image_route(ImageProtocol::Kitty, plain_tmux);
+  EXPECT_FALSE(kitty.shown);
+  EXPECT_NE(kitty.why.find("tmux set -g allow-passthrough on"), std::string::npos) << kitty.why;
+  const ImageRoute through = image_route(ImageProtocol::Kitty, TmuxFacts{.inside = true, .passthrough = true});
+  EXPECT_TRUE(through.shown && through.tmux_passthrough);
+}
+
+TEST(TerminalImage, TmuxPassthroughWrapsEachSequenceWithItsEscapesDoubled) {
+  EXPECT_EQ(tmux_passthrough("\x1b_Ga=T,m=1;AAAA\x1b\\\x1b_Gm=0;BB\x1b\\"),
+            "\x1bPtmux;\x1b\x1b_Ga=T,m=1;AAAA\x1b\x1b\\\x1b\\\x1bPtmux;\x1b\x1b_Gm=0;BB\x1b\x1b\\\x1b\\");
+  EXPECT_EQ(tmux_passthrough(""), "");
+}
+
+TEST(InteractiveShell, ShowRefusesWhatWouldNotReachTheScreenAndClearClearsATerminal) {
+  RelightSession session = make_session();
+  InteractiveOptions opts;
+  opts.image_route = [](ImageProtocol p) { return image_route(p, TmuxFacts{.inside = true}); };
+  int failures = 0;
+  std::string text = run(session, "show kitty\nshow sixel\nshow blocks\nclear\n", &failures, opts);
+  EXPECT_EQ(failures, 2);
+  EXPECT_NE(text.find("error: show kitty: inside tmux"), std::string::npos) << text;
+  EXPECT_NE(text.find("error: show sixel: this tmux draws no sixel images"), std::string::npos) << text;
+  EXPECT_EQ(count(text, "drawn in "), 1u) << "only the half blocks are drawn: " << text;
+  EXPECT_EQ(text.find("\x1b_G"), std::string::npos);
+  EXPECT_EQ(text.find("\x1b[2J"), std::string::npos) << "clear writes nothing into a pipe";
+  opts.image_route = [](ImageProtocol p) { return image_route(p, TmuxFacts{.inside = true, .passthrough = true}); };
+  opts.terminal_output = true;
+  text = run(session, "show kitty\nclear\n", &failures, opts);
+  EXPECT_EQ(failures, 0) << text;
+  EXPECT_NE(text.find("\x1bPtmux;\x1b\x1b_Ga=T"), std::string::npos);
+  EXPECT_NE(text.find("through tmux's passthrough"), std::string::npos);
+  EXPECT_NE(text.find("\x1b[H\x1b[2J"), std::string::npos);
+}
+
 TEST(LineReader, StreamReaderStripsCarriageReturnsAndPrompts) {
   std::istringstream in("status\r\nquit\n");
   std::ostringstream prompts;

@@ -5,6 +5,7 @@
 #include <nifti1_io.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "prizma/render/render.h"
 #include "prizma/render/volume.h"
@@ -113,12 +114,13 @@ TEST(NiftiOrientation, QformWhenNoSformAndSformPreferred) {
   EXPECT_NE(n.orientation.find("none"), std::string::npos) << n.orientation;
 }
 
-// Renders a 4×1×1 volume whose file voxel 0 absorbs, seen from above (+z = S) with +x to the right:
-// returns the index of the darkest of the 4 pixels.
-int darkest_pixel(const ScratchDir& dir, const std::string& file) {
+// Renders a 4×1×1 volume whose file voxel 0 absorbs, by default seen from above (+z = S) with +x to
+// the right: returns the index of the darkest of the 4 pixels.
+int darkest_pixel(const ScratchDir& dir, const std::string& file, const std::string& position = "[0, 0, 2]",
+                  const std::string& up = "[0, 1, 0]") {
   dir.write("s.json", R"({"volume": {"type": "nifti", "path": ")" + file + R"(", "interpolation": "nearest"},
     "materials": [{"range": [50, 1000], "albedo": 0, "extinction": 20}],
-    "camera": {"type": "orthographic", "position": [0, 0, 2], "look_at": [0, 0, 0], "up": [0, 1, 0],
+    "camera": {"type": "orthographic", "position": )" + position + R"(, "look_at": [0, 0, 0], "up": )" + up + R"(,
                "ortho_height": 0.25, "width": 4, "height": 1},
     "lights": [{"name": "env", "direction": [0, 0, 0]}], "bins": "linear:400:700:1", "samples": 16, "seed": 1})");
   const auto img = render(load_scene(dir / "s.json"));
@@ -140,6 +142,37 @@ TEST(NiftiOrientation, FlippedAxisMovesTheVoxelToTheMirroredPixel) {
   EXPECT_EQ(darkest_pixel(dir, "las.nii"), 3);  // +i → L: voxel 0 is the right-most (largest x)
   const Scene s = load_scene(dir / "s.json");
   EXPECT_NE(s.volume_note.find("NIfTI orientation (sform)"), std::string::npos) << s.volume_note;
+}
+
+TEST(NiftiOrientation, SeenFromTheFrontThePatientsLeftIsOnTheImagesRight) {
+  // docs/scene-format.md: a RAS file whose voxel 0 (the least x: the patient's left-most) absorbs.
+  // The front of the patient is anterior, +y: a camera there looking toward −y with up +z (S) faces
+  // the patient and sees the patient's left on the image's right, as when facing a person; from
+  // behind (−y) it is on the left.
+  ScratchDir dir;
+  write_oriented(dir / "ras.nii", {4, 1, 1}, {1, 1, 1}, {1, affine({{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}})}, 0,
+                 {0, 0, 0, 1}, {200, 0, 0, 0});
+  EXPECT_EQ(darkest_pixel(dir, "ras.nii", "[0, 2, 0]", "[0, 0, 1]"), 3);
+  EXPECT_EQ(darkest_pixel(dir, "ras.nii", "[0, -2, 0]", "[0, 0, 1]"), 0);
+}
+
+TEST(NiftiOrientation, AnObliqueFileIsSnappedWithAWarningEveryRender) {
+  // An sform turned 10° about the superior axis: the axes snap to R, A, S and the volume's
+  // warnings (printed by prizma-render without --verbose, returned by prizma.render) say by how much.
+  ScratchDir dir;
+  const float c = std::cos(10.0f * std::numbers::pi_v<float> / 180.0f), s = std::sin(10.0f * std::numbers::pi_v<float> / 180.0f);
+  write_oriented(dir / "oblique.nii", {2, 2, 2}, {1, 1, 1}, {1, affine({{{c, -s, 0, 0}, {s, c, 0, 0}, {0, 0, 1, 0}}})}, 0,
+                 {0, 0, 0, 1}, index_values(8));
+  const Volume vol = load_nifti_volume(dir / "oblique.nii");
+  ASSERT_EQ(vol.warnings.size(), 1u);
+  EXPECT_EQ(vol.warnings[0], (dir / "oblique.nii").string() +
+                                 ": NIfTI orientation: the sform is oblique (a file axis is 10.0° from the nearest "
+                                 "anatomical axis); its axes were snapped to the nearest (file +i→R +j→A +k→S), not "
+                                 "resampled, so the volume is rotated by up to 10.0° from the patient's frame");
+  EXPECT_NE(vol.orientation.find("oblique axes snapped"), std::string::npos) << vol.orientation;
+  write_oriented(dir / "straight.nii", {2, 2, 2}, {1, 1, 1}, {1, affine({{{-1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}})},
+                 0, {0, 0, 0, 1}, index_values(8));
+  EXPECT_TRUE(load_nifti_volume(dir / "straight.nii").warnings.empty());
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <vector>
 
+#include "environment_test_util.h"
 #include "prizma/render/environment_map.h"
 #include "prizma/render/light_sampler.h"
 #include "prizma/render/render.h"
@@ -331,15 +332,7 @@ TEST(EnvironmentMap, DensityIntegratesToOneAndMatchesItsSamples) {
     x = static_cast<float>((state >> 8) % 1000) / 100.0f;
   }
   const EnvironmentMap map(w, h, v, 33.0, "test");
-  const int nt = 400, np = 800;
-  double integral = 0.0;
-  for (int i = 0; i < nt; ++i)
-    for (int j = 0; j < np; ++j) {
-      const double theta = std::numbers::pi * (i + 0.5) / nt, phi = 2.0 * std::numbers::pi * (j + 0.5) / np;
-      const Eigen::Vector3d d(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
-      integral += map.pdf(d) * std::sin(theta) * (std::numbers::pi / nt) * (2.0 * std::numbers::pi / np);
-    }
-  EXPECT_NEAR(integral, 1.0, 2e-3);
+  EXPECT_NEAR(testing::pdf_integral_over_sphere(map), 1.0, 2e-3);
 
   double exact = 0.0;
   for (int y = 0; y < h; ++y)

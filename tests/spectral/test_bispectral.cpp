@@ -5,10 +5,12 @@
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
+#include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -105,6 +107,64 @@ TEST(Bispectral, HalfFilesRoundTripTheHalfValues) {
   ASSERT_EQ(back.reradiation, img.reradiation);
   for (std::size_t k = 0; k < img.lights[1].reradiation.size(); ++k)
     EXPECT_NEAR(back.lights[1].reradiation[k], img.lights[1].reradiation[k], 1e-3f * img.lights[1].reradiation[k]);
+}
+
+// issue 25 item 11: the JCGT reference library reads a file's re-radiation (its top-level channels
+// T.<λin>nm.<λout>nm) only when they are every pair with λin < λout of its T.<λ>nm wavelengths and no
+// other (EXRBiSpectralImage reads exactly n(n−1)/2 channels; a missing or a reversed pair crashed
+// it). Prizma writes the top level that way — the lights' sum, 0 where it holds nothing, no reversed
+// pair — and keeps every pair it holds, the reversed one too, in the light layers it reads back.
+TEST(Bispectral, TopLevelIsTheReferenceLayoutsFullUpperTriangle) {
+  for (const auto& names : {std::vector<std::string>{"uv"}, std::vector<std::string>{"uv", "sky"}}) {
+    SpectralImage img = bispectral_image(names);
+    img.reradiation = {{0, 2}, {0, 3}, {1, 3}, {3, 1}};  // (3 → 1): overlapping spectra, λin > λout
+    for (auto& light : img.lights) {
+      for (std::size_t px = 0; px < img.pixel_count(); ++px) light.reradiation.push_back(0.5f + 0.01f * static_cast<float>(px));
+      std::vector<float> interleaved;  // pairs contiguous per pixel: 3 old values, then the new one
+      for (std::size_t px = 0; px < img.pixel_count(); ++px) {
+        for (int q = 0; q < 3; ++q) interleaved.push_back(light.reradiation[px * 3 + static_cast<std::size_t>(q)]);
+        interleaved.push_back(light.reradiation[img.pixel_count() * 3 + px]);
+      }
+      light.reradiation = interleaved;
+    }
+    std::sort(img.reradiation.begin(), img.reradiation.end(),
+              [](const BinPair& a, const BinPair& b) { return a.in != b.in ? a.in < b.in : a.out < b.out; });
+    // (sorted: (0,2) (0,3) (1,3) (3,1): the order the values were laid out in)
+    const Scratch file("published.exr");
+    write_spectral_exr(file.path(), img);
+
+    // The top level, as the reference reader sees it: the diagonal and exactly the 6 pairs in < out.
+    Imf::InputFile in(file.path().c_str());
+    std::vector<std::string> top_pairs;
+    for (auto it = in.header().channels().begin(); it != in.header().channels().end(); ++it) {
+      const std::string name = it.name();
+      if (name.rfind("T.", 0) == 0 && std::count(name.begin(), name.end(), 'n') == 2) top_pairs.push_back(name);
+    }
+    std::vector<std::string> expected;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) expected.push_back(reradiation_channel_name(img.bins.centre_nm(a), img.bins.centre_nm(b)));
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(top_pairs, expected) << names.size() << " lights";
+    // Their values: the lights' sum for the pairs held, 0 for the others.
+    const auto dw = in.header().dataWindow();
+    std::vector<float> v02(img.pixel_count()), v12(img.pixel_count(), -1.0f);
+    Imf::FrameBuffer fb;
+    fb.insert(reradiation_channel_name(img.bins.centre_nm(0), img.bins.centre_nm(2)), Imf::Slice::Make(Imf::FLOAT, v02.data(), dw, sizeof(float), sizeof(float) * 3));
+    fb.insert(reradiation_channel_name(img.bins.centre_nm(1), img.bins.centre_nm(2)), Imf::Slice::Make(Imf::FLOAT, v12.data(), dw, sizeof(float), sizeof(float) * 3));
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+    for (std::size_t px = 0; px < img.pixel_count(); ++px) {
+      double sum = 0.0;
+      for (const auto& light : img.lights) sum += light.reradiation[px * 4 + 0];
+      EXPECT_EQ(v02[px], static_cast<float>(sum)) << px;
+      EXPECT_EQ(v12[px], 0.0f) << px;  // (1 → 2) held by no light
+    }
+    // Prizma reads back what it holds, the reversed pair included, from the light layers.
+    const SpectralImage back = read_spectral_exr(file.path());
+    EXPECT_EQ(back.reradiation, img.reradiation);
+    for (std::size_t l = 0; l < names.size(); ++l) EXPECT_EQ(back.lights[l].reradiation, img.lights[l].reradiation);
+    EXPECT_EQ(back.lights[0].name, "uv");
+  }
 }
 
 // A file as another tool writes the reference layout: no prizma: attributes, wavelengths in other

@@ -45,7 +45,7 @@ TEST(LightRecord, RendererRecordsReadBackAndPrintAsBefore) {
 }
 
 TEST(LightRecord, OnlyTheFieldsThatAreSetAreWritten) {
-  EXPECT_EQ(light_records_json({LightRecord{.name = "a", .spectrum = "D65"}, LightRecord{.name = "b"}}),
+  EXPECT_EQ(light_records_json({light_record("a", "D65"), light_record("b")}),
             R"([{"name":"a","spectrum":"D65"},{"name":"b"}])");
   EXPECT_EQ(light_records_json(light_records_for({"key", "fill"})), R"([{"name":"key"},{"name":"fill"}])");
   EXPECT_EQ(light_records_json({}), "[]");
@@ -86,14 +86,14 @@ TEST(LightRecord, RecordsMustDescribeTheLayers) {
 }
 
 TEST(LightRecord, DefaultSpectrumRule) {
-  const std::vector<LightRecord> two = {{.name = "key", .spectrum = "A"}, {.name = "sky", .spectrum = "D65*0.2"}};
+  const std::vector<LightRecord> two = {light_record("key", "A"), light_record("sky", "D65*0.2")};
   EXPECT_EQ(default_spectrum(two, "sky", 2), "D65*0.2");
   EXPECT_EQ(default_spectrum(two, "key", 3), "A");
   EXPECT_EQ(default_spectrum(two, "other", 3), "D65");
   // One layer, one record: that record's spectrum whatever the names (a one-light render's layer is
   // the top level, read back as the record's name or "default").
-  EXPECT_EQ(default_spectrum({{.name = "sun", .spectrum = "F11"}}, "default", 1), "F11");
-  EXPECT_EQ(default_spectrum({{.name = "sun"}}, "sun", 1), "D65");  // nothing recorded
+  EXPECT_EQ(default_spectrum({light_record("sun", "F11")}, "default", 1), "F11");
+  EXPECT_EQ(default_spectrum({light_record("sun")}, "sun", 1), "D65");  // nothing recorded
   EXPECT_EQ(default_spectrum({}, "sun", 1), "D65");
 }
 

@@ -417,6 +417,32 @@ TEST_F(SpectralExr, ReadsPublishedSingleLayerLayoutWithMidpointEdges) {
   }
 }
 
+// issue 25 item 13: the reference writer's reflective file sampled at 400, 500, 600, 700 nm (no
+// prizma:binEdgesNm) infers a first edge of 350 nm, below the colour matching tables: clamped to
+// 360 nm and noted (prizma-relight -v prints it); a channel itself outside the tables is refused.
+TEST_F(SpectralExr, InferredOuterEdgesAreClampedToTheTablesAndNoted) {
+  const fs::path p = file("ref400.exr");
+  write_plain_exr(p, 2, 2, {"T.400nm", "T.500nm", "T.600nm", "T.700nm"}, {0.1f, 0.2f, 0.3f, 0.4f});
+  const SpectralImage img = read_spectral_exr(p);
+  const std::vector<double> edges = {360, 450, 550, 650, 750};  // midpoints: exact up to rounding
+  ASSERT_EQ(img.bins.edges_nm().size(), edges.size());
+  for (std::size_t i = 0; i < edges.size(); ++i) EXPECT_NEAR(img.bins.edges_nm()[i], edges[i], 1e-9) << i;
+  ASSERT_EQ(img.info.notes.size(), 1u);
+  EXPECT_NE(img.info.notes[0].find("inferred first bin edge 350 nm is outside the colour matching tables (360–830 nm): "
+                                   "clamped to 360 nm"), std::string::npos) << img.info.notes[0];
+  // Both ends: 370 and 820 nm mirror to 320 and 870 nm.
+  const fs::path wide = file("wide_ends.exr");
+  write_plain_exr(wide, 1, 1, {"T.370nm", "T.595nm", "T.820nm"}, {1, 1, 1});
+  const SpectralImage w = read_spectral_exr(wide);
+  EXPECT_EQ(w.bins.min_nm(), 360.0);
+  EXPECT_EQ(w.bins.max_nm(), 830.0);
+  EXPECT_EQ(w.info.notes.size(), 2u);
+  // A sample at 350 nm cannot be given a bin inside the tables.
+  const fs::path outside = file("uv.exr");
+  write_plain_exr(outside, 1, 1, {"T.350nm", "T.450nm"}, {1, 1});
+  EXPECT_NE(read_error(outside).find("bin edges:"), std::string::npos) << read_error(outside);
+}
+
 TEST_F(SpectralExr, ReadsNonUniformPublishedLayoutSortedByWavelength) {
   // Alphabetical channel order ("T.1000nm" < "T.450nm"... not here, but "T.0,5um" < "T.450nm") differs
   // from wavelength order; half pixels are converted.

@@ -4,7 +4,6 @@
 // (connection_pool.h), PageAccess decides who may ask (page_access.h), SaveFolder where Save writes.
 #include "prizma/relight/serve.h"
 
-#include <Imath/half.h>
 #include <arpa/inet.h>
 #include <httplib.h>
 #include <netinet/in.h>
@@ -26,10 +25,11 @@
 #include <system_error>
 #include <thread>
 
+#include "page_transport.h"
+#include "prizma/relight/canvas_colour_space.h"
 #include "prizma/relight/connection_pool.h"
 #include "prizma/relight/save_folder.h"
 #include "prizma/relight/serve_state.h"
-#include "prizma/spectral/bispectral.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
@@ -44,12 +44,8 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 using spectral::InputError;
 
-// Transport texels pack four bins each (RGBA); bins past the last are zero.
-constexpr int kBinsPerTexel = 4;
 // Request bodies: the API takes none (its parameters are in the URL).
 constexpr std::size_t kMaxBodyBytes = std::size_t{1} << 16;
-
-int texel_groups(int bins) { return (bins + kBinsPerTexel - 1) / kBinsPerTexel; }
 
 void send_json(httplib::Response& res, const json& body, int status = 200) {
   res.status = status;
@@ -155,14 +151,13 @@ struct RelightServer::Impl {
   int port = 0;
   std::mutex mutex;  // guards session and caches (handlers run on the pool's workers)
   std::map<std::string, std::string> display_cache;
-  // Bispectral files: K per observer, computed on first use (the page's re-radiation textures).
-  std::map<spectral::Observer, spectral::ReradiationWeights> reradiation_cache;
+  PageTransport transport;  // the texture layers and their weights (bins or coefficients)
   // Last: destroyed first, so its workers have stopped before anything their handlers use goes.
   std::unique_ptr<ConnectionPool> pool;
 
   Impl(RelightSession& s, const ServeOptions& o)
       : session(s), opts(o), base(s.settings()), save_folder(o.save_dir, s.source()),
-        access(PageAccess::new_token(), o.bind, 0) {}
+        access(PageAccess::new_token(), o.bind, 0), transport(s) {}
 
   // Refuses (403) a request PageAccess refuses, naming why; reported on opts.log too.
   httplib::Server::HandlerResponse check_access(const httplib::Request& req, httplib::Response& res) {
@@ -212,94 +207,26 @@ struct RelightServer::Impl {
                         {"default", session.default_lights()[l].text},
                         {"spec", base.lights[l].text}});
     }
-    spectral::DisplayOptions d = base.output.display;
-    d.colour_space.clear();
-    // Bispectral files: per light ⌈3·|in|/4⌉ more texture layers after the diagonal's, holding K
-    // (X, Y, Z rows of |in| values each) for one observer.
-    json rerad = nullptr;
-    if (!img.reradiation.empty()) {
-      json pairs = json::array();
-      for (const auto& pr : img.reradiation) pairs.push_back({pr.in, pr.out});
-      const std::vector<int> in = spectral::reradiation_in_bins(img);
-      rerad = {{"inBins", in}, {"groups", texel_groups(3 * static_cast<int>(in.size()))}, {"pairs", pairs}};
+    // Per display of the config, the canvas colour space that shows it (null: none; the page then
+    // says so and shows another display) and what it encodes.
+    json spaces = json::object();
+    for (const std::string& name : spectral::DisplayTransform(display_options("")).displays()) {
+      const CanvasColourSpace cs = canvas_colour_space(spectral::DisplayTransform(display_options(name)), name);
+      spaces[name] = {{"canvas", cs.canvas.empty() ? json(nullptr) : json(cs.canvas)}, {"encoding", cs.encoding}};
     }
-    return {{"source", fs::path(session.source()).filename().string()},
-            {"version", spectral::prizma_version()},
-            {"width", img.width},
-            {"height", img.height},
-            {"bins", img.bins.edges_nm()},
-            {"binsPerTexel", kBinsPerTexel},
-            {"groups", texel_groups(img.bins.size())},
-            {"lights", lights},
-            {"state", state_string(base, session)},
-            {"displays", spectral::DisplayTransform(d).displays()},
-            {"observers", {"1931", "1964", "2012-2", "2012-10"}},
-            {"spectra", spectral::named_illuminants()},
-            {"reradiation", rerad}};
-  }
-
-  int reradiation_groups() const {
-    const auto& img = session.image();
-    return img.reradiation.empty() ? 0 : texel_groups(3 * static_cast<int>(spectral::reradiation_in_bins(img).size()));
-  }
-
-  // K of every light for one observer (call with the mutex held).
-  const spectral::ReradiationWeights& reradiation(spectral::Observer cmf) {
-    auto it = reradiation_cache.find(cmf);
-    if (it == reradiation_cache.end())
-      it = reradiation_cache.emplace(cmf, spectral::reradiation_weights(session.image(), cmf)).first;
-    return it->second;
-  }
-
-  // One texture layer: light l, bins [4g, 4g + 4) of every pixel as RGBA texels, rows top first; for
-  // g past the diagonal's groups, values [4g', 4g' + 4) of the light's K (3·|in| per pixel) for `cmf`.
-  std::string transport(int l, int g, bool half, spectral::Observer cmf) {
-    const auto& img = session.image();
-    const int groups = texel_groups(img.bins.size());
-    const std::vector<float>* values = &img.lights[static_cast<std::size_t>(l)].data;
-    int n = img.bins.size();
-    if (g >= groups) {
-      const std::lock_guard lock(mutex);
-      const spectral::ReradiationWeights& k = reradiation(cmf);
-      values = &k.per_light[static_cast<std::size_t>(l)];
-      n = 3 * static_cast<int>(k.in_bins.size());
-      g -= groups;
-    }
-    const auto& data = *values;
-    const std::size_t pixels = img.pixel_count();
-    std::string out(pixels * kBinsPerTexel * (half ? sizeof(std::uint16_t) : sizeof(float)), '\0');
-    for (std::size_t p = 0; p < pixels; ++p) {
-      for (int c = 0; c < kBinsPerTexel; ++c) {
-        const int i = g * kBinsPerTexel + c;
-        const float v = i < n ? data[p * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)] : 0.0f;
-        const std::size_t k = p * kBinsPerTexel + static_cast<std::size_t>(c);
-        if (half) {
-          const std::uint16_t bits = Imath::half(v).bits();
-          std::memcpy(out.data() + k * sizeof bits, &bits, sizeof bits);
-        } else {
-          std::memcpy(out.data() + k * sizeof v, &v, sizeof v);
-        }
-      }
-    }
+    json out = {{"source", fs::path(session.source()).filename().string()},
+                {"version", spectral::prizma_version()},
+                {"width", img.width},
+                {"height", img.height},
+                {"bins", img.bins.edges_nm()},
+                {"lights", lights},
+                {"state", state_string(base, session)},
+                {"displays", spectral::DisplayTransform(display_options("")).displays()},
+                {"displaySpaces", spaces},
+                {"observers", {"1931", "1964", "2012-2", "2012-10"}},
+                {"spectra", spectral::named_illuminants()}};
+    out.update(transport.describe());
     return out;
-  }
-
-  json weights(const RelightSettings& s) const {
-    const spectral::RelightMatrix m(session.image().bins, s.lights, s.relight);
-    spectral::ReradiationWeights in_bins;  // only the in bins: the weights of K do not depend on K
-    in_bins.in_bins = spectral::reradiation_in_bins(session.image());
-    json lights = json::array();
-    for (int l = 0; l < m.light_count(); ++l) {
-      const spectral::Matrix3Xd& w = m.light(l);
-      std::vector<double> rows;  // row-major X, Y, Z rows of n weights
-      for (int c = 0; c < 3; ++c)
-        for (int i = 0; i < m.bin_count(); ++i) rows.push_back(w(c, i));
-      json light = {{"name", session.light_names()[static_cast<std::size_t>(l)]}, {"on", !w.isZero(0.0)}, {"w", rows}};
-      // Bispectral: the weights of K (3 × 3·|in|, row-major), what spectral::relight_into uses (relight_image.h).
-      if (!session.image().reradiation.empty()) light["wr"] = spectral::reradiation_term_weights(m, in_bins, l).weights;
-      lights.push_back(std::move(light));
-    }
-    return {{"state", state_string(s, session)}, {"lights", lights}, {"white", vec3(m.mix_white_xyz())}};
   }
 
   // The lights' bin averages times their scales, for the page's plot.
@@ -317,13 +244,20 @@ struct RelightServer::Impl {
     return {{"lights", lights}};
   }
 
-  std::string display_shader(const std::string& name) {
-    if (const auto it = display_cache.find(name); it != display_cache.end()) return it->second;
+  // The command line's OCIO config with display `name` and its default view (empty: the starting display).
+  spectral::DisplayOptions display_options(const std::string& name) const {
     spectral::DisplayOptions d = base.output.display;
     d.colour_space.clear();
-    d.display = name;
-    d.view.clear();
-    const spectral::DisplayShader shader = spectral::DisplayTransform(d).gpu_shader();
+    if (!name.empty()) {
+      d.display = name;
+      d.view.clear();
+    }
+    return d;
+  }
+
+  std::string display_shader(const std::string& name) {
+    if (const auto it = display_cache.find(name); it != display_cache.end()) return it->second;
+    const spectral::DisplayShader shader = spectral::DisplayTransform(display_options(name)).gpu_shader();
     json uniforms = json::array(), textures = json::array();
     for (const auto& u : shader.uniforms) uniforms.push_back({{"name", u.name}, {"type", u.type}, {"values", u.values}});
     for (const auto& t : shader.textures) {
@@ -379,7 +313,8 @@ void RelightServer::Impl::routes() {
       res.set_content(std::string(detail::web_asset("index.html")), "text/html; charset=utf-8");
     });
   }
-  for (const auto& [route, script] : {std::pair{"/app\\.js", "app.js"}, std::pair{"/state\\.js", "state.js"}}) {
+  for (const auto& [route, script] : {std::pair{"/app\\.js", "app.js"}, std::pair{"/state\\.js", "state.js"},
+                                      std::pair{"/plots\\.js", "plots.js"}, std::pair{"/gpu\\.js", "gpu.js"}}) {
     server.Get(route, [script = script](const httplib::Request&, httplib::Response& res) {
       res.set_content(std::string(detail::web_asset(script)), "text/javascript; charset=utf-8");
     });
@@ -391,17 +326,19 @@ void RelightServer::Impl::routes() {
   server.Get("/api/transport", guarded([this](const httplib::Request& req, httplib::Response& res) {
     const auto& img = session.image();
     const int l = int_param(req, "light", 0, static_cast<int>(img.lights.size()) - 1);
-    const int g = int_param(req, "group", 0, texel_groups(img.bins.size()) + reradiation_groups() - 1);
+    const int g = int_param(req, "group", 0, transport.groups() + transport.reradiation_groups() - 1);
     const std::string type = req.has_param("type") ? req.get_param_value("type") : "f32";
     if (type != "f32" && type != "f16") throw InputError("type", "expected f32 or f16, not \"" + type + "\"");
     const spectral::Observer cmf =
         req.has_param("cmf") ? spectral::parse_observer(req.get_param_value("cmf"), "cmf") : base.relight.cmf;
-    res.set_content(transport(l, g, type == "f16", cmf), "application/octet-stream");
+    res.set_content(transport.layer(l, g, type == "f16", cmf), "application/octet-stream");
   }));
   server.Get("/api/weights", guarded([this](const httplib::Request& req, httplib::Response& res) {
     const std::lock_guard lock(mutex);
     apply_state(req, {});
-    send_json(res, weights(session.settings()));
+    json body = transport.weights(session.settings());
+    body["state"] = state_string(session.settings(), session);
+    send_json(res, body);
   }));
   server.Get("/api/spectra", guarded([this](const httplib::Request& req, httplib::Response& res) {
     const std::lock_guard lock(mutex);
@@ -422,6 +359,11 @@ void RelightServer::Impl::routes() {
     const auto& pairs_held = session.image().reradiation;
     for (std::size_t l = 0; l < p.bins.size(); ++l) {
       json entry = {{"name", session.light_names()[l]}, {"bins", p.bins[l]}};
+      if (const CompressedTransport* c = session.coefficients()) {  // what the page relights: B·c
+        const Eigen::VectorXf t = reconstructed_spectrum(c->lights[l], static_cast<std::size_t>(y) * session.image().width +
+                                                                             static_cast<std::size_t>(x));
+        entry["coefficientBins"] = std::vector<float>(t.data(), t.data() + t.size());
+      }
       if (!p.reradiation.empty()) {  // bispectral: the pixel's off-diagonal M[out][in], as [in, out, value]
         json pairs = json::array();
         for (std::size_t q = 0; q < pairs_held.size(); ++q)

@@ -84,6 +84,31 @@ const PrizmaState = (() => {
     return s;
   }
 
+  // The spectrum menu's value for a light's controls: 'named:D65', 'blackbody', 'gaussian', 'custom'.
+  function kindValue(l) { return l.kind === 'named' ? 'named:' + l.named : l.kind; }
+
+  // The controls after choosing `value` in a light's spectrum menu: that kind, switched on, with the
+  // parameters it had before (temperature, centre, FWHM) or their defaults. "other spec…" starts
+  // from the spec shown so far, so the URL holds a spec the server takes from the first frame on.
+  function chooseKind(l, value) {
+    const out = Object.assign({}, l, { on: true });
+    if (value.startsWith('named:')) {
+      out.kind = 'named';
+      out.named = value.slice(6);
+    } else if (value === 'custom') {
+      if (!out.custom) out.custom = specOf(Object.assign({}, l, { on: true, scale: 1 }));
+      out.kind = 'custom';
+    } else {
+      out.kind = value;
+    }
+    return out;
+  }
+
+  // Which parameter rows a spectrum kind shows: its own, and only those.
+  function fieldsOf(kind) {
+    return { temp: kind === 'blackbody', centre: kind === 'gaussian', fwhm: kind === 'gaussian', custom: kind === 'custom' };
+  }
+
   // The state string of a view: every light in `lights` ([[name, spec], …], the file's order),
   // then exposure, cmf, display, adapt. Never the secret.
   function stateString(lights, view) {
@@ -102,7 +127,8 @@ const PrizmaState = (() => {
     return d;
   }
 
-  return { enc, parseQuery, splitFragment, parseSpec, specOf, stateValues, stateString, stateValue };
+  return { enc, parseQuery, splitFragment, parseSpec, specOf, kindValue, chooseKind, fieldsOf, stateValues, stateString,
+           stateValue };
 })();
 
 if (typeof module !== 'undefined') module.exports = PrizmaState;

@@ -1,5 +1,6 @@
 #include "prizma/relight/interactive_shell.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -44,12 +45,13 @@ constexpr const char* kHelp =
     "  probe X Y [LIGHT]     bins, XYZ, Lab (D65 white) and sRGB at a pixel; fluorescent files: the\n"
     "                        excitation–emission map per light (or of LIGHT)\n"
     "  compare X1 Y1 X2 Y2 [R]  CIEDE2000 between two pixels or the means of two (2R+1)² squares\n"
+    "  clear                 clear the screen (Ctrl-L too)\n"
     "  help                  this text\n"
-    "  quit                  leave (end of input, Ctrl-D, does too)\n";
+    "  quit                  leave (Ctrl-D on an empty line too; Ctrl-C only cancels the line)\n";
 
-const std::vector<std::string> kCommands = {"adapt", "cmf",    "compare", "display", "exposure", "help",
-                                            "light", "lights", "probe",   "quit",    "save",     "show",
-                                            "status", "undo"};
+const std::vector<std::string> kCommands = {"adapt",  "clear", "cmf",   "compare", "display", "exposure",
+                                            "help",   "light", "lights", "probe",  "quit",    "save",
+                                            "show",   "status", "undo"};
 
 double to_double(const std::string& s, const std::string& input) {
   double v = 0.0;
@@ -166,13 +168,20 @@ class Shell {
     if (m_opts.show_every || (first && m_opts.show)) draw(std::nullopt);
   }
 
+  // Draws the image; a protocol whose image would not reach the screen (inside tmux) is an InputError
+  // saying what to do, never a drawing of nothing.
   void draw(std::optional<ImageProtocol> forced) {
     if (!forced && !m_protocol) m_protocol = m_opts.detect_protocol ? m_opts.detect_protocol() : m_opts.protocol;
+    const ImageProtocol protocol = forced ? *forced : *m_protocol;
+    ImageRoute route;
+    if (protocol != ImageProtocol::Blocks && m_opts.image_route) route = m_opts.image_route(protocol);
+    if (!route.shown) throw InputError(std::string("show ") + image_protocol_name(protocol), route.why);
     const TerminalSize size = m_opts.terminal_size ? m_opts.terminal_size() : m_opts.terminal;
     const spectral::XyzImage& img = m_session.xyz();
     m_out << std::flush;
-    draw_terminal_image(m_out, spectral::to_display(img, m_session.display()), img.width, img.height,
-                        forced ? *forced : *m_protocol, size);
+    draw_terminal_image(m_out, spectral::to_display(img, m_session.display()), img.width, img.height, protocol, size, 3,
+                        route.tmux_passthrough);
+    if (route.tmux_passthrough) m_out << "(kitty graphics through tmux's passthrough: tmux neither moves nor clears them)\n";
   }
 
   // Applies a change through `change` (which throws, leaving the session as it was, on bad input),
@@ -242,13 +251,17 @@ bool parse_on_off(const std::string& s) {
   throw InputError("adapt", "on or off, not \"" + s + "\"");
 }
 
-void run_command(RelightSession& session, Shell& shell, std::ostream& out, const std::vector<std::string>& w) {
+void run_command(RelightSession& session, Shell& shell, std::ostream& out, const std::vector<std::string>& w,
+                 const InteractiveOptions& opts) {
   const std::string& cmd = w[0];
   const long long width = session.image().width, height = session.image().height;
   const std::string size = std::to_string(width) + "×" + std::to_string(height) + " image";
   if (cmd == "help") {
     expect_args(w, 0, 1, "help");
     out << kHelp;
+  } else if (cmd == "clear") {
+    expect_args(w, 0, 0, "clear");
+    if (opts.terminal_output) out << "\x1b[H\x1b[2J" << std::flush;  // home, erase the screen (as clear(1) without E3)
   } else if (cmd == "lights") {
     expect_args(w, 0, 0, "lights");
     out << session.describe_lights();
@@ -399,7 +412,7 @@ int run_interactive(RelightSession& session, LineReader& in, std::ostream& out, 
       const std::vector<std::string> w = split_words(line);
       if (w.empty()) continue;
       if (w[0] == "quit" || w[0] == "exit") break;
-      run_command(session, shell, out, w);
+      run_command(session, shell, out, w, opts);
     } catch (const std::exception& e) {
       out << "error: " << e.what() << "\n";
       ++failures;
@@ -420,6 +433,10 @@ int run_interactive_terminal(RelightSession& session, InteractiveOptions opts, s
   if (out_tty && !opts.detect_protocol) {
     opts.detect_protocol = [] { return detect_image_protocol(STDIN_FILENO, STDOUT_FILENO); };
   }
+  if (out_tty && !opts.image_route) {
+    opts.image_route = [](ImageProtocol p) { return image_route(p, tmux_facts(p, STDIN_FILENO, STDOUT_FILENO)); };
+  }
+  opts.terminal_output = out_tty;
   if (!in_tty || !out_tty) {
     opts.prompt = opts.prompt || in_tty;
     return run_interactive(session, std::cin, std::cout, opts);
@@ -431,7 +448,22 @@ int run_interactive_terminal(RelightSession& session, InteractiveOptions opts, s
   };
   ro.warnings = &warnings;
   const std::unique_ptr<LineReader> reader = make_terminal_line_reader(std::move(ro));
-  return run_interactive(session, *reader, std::cout, opts);
+  // As in bash, Ctrl-C never ends the session: at the prompt the reader takes it as a key (it cancels
+  // the line); while a command runs (they take milliseconds) it is ignored, so a key pressed a moment
+  // late does not end the session either. Restored when the session ends.
+  struct sigaction ignore{}, before{};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  ::sigaction(SIGINT, &ignore, &before);
+  int failures = 0;
+  try {
+    failures = run_interactive(session, *reader, std::cout, opts);
+  } catch (...) {
+    ::sigaction(SIGINT, &before, nullptr);
+    throw;
+  }
+  ::sigaction(SIGINT, &before, nullptr);
+  return failures;
 }
 
 }  // namespace prizma::relight

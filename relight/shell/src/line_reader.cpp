@@ -92,6 +92,11 @@ class EditLineReader final : public LineReader {
     // them and never frees the copies.
     el_wset(m_el, EL_ADDFN, L"prizma-complete", L"complete the word at the cursor", &EditLineReader::complete);
     el_set(m_el, EL_BIND, "^I", "prizma-complete", nullptr);
+    // Ctrl-C cancels the line being typed, as in bash, and never ends the session: while a line is
+    // edited the terminal sends it as a key (no SIGINT: -isig in libedit's edit mode), bound here.
+    el_set(m_el, EL_SETTY, "-d", "-isig", nullptr);
+    el_wset(m_el, EL_ADDFN, L"prizma-cancel", L"cancel the line (as Ctrl-C in bash)", &EditLineReader::cancel);
+    el_set(m_el, EL_BIND, "^C", "prizma-cancel", nullptr);
     el_source(m_el, nullptr);  // the user's ~/.editrc, as every libedit program reads it
   }
 
@@ -105,6 +110,10 @@ class EditLineReader final : public LineReader {
   bool read_line(std::string& line) override {
     int count = 0;
     const char* text = el_gets(m_el, &count);
+    while (m_cancelled) {  // Ctrl-C: the line is dropped (not run, not in the history); a new prompt
+      m_cancelled = false;
+      text = el_gets(m_el, &count);
+    }
     if (!text || count <= 0) {
       // End of input (Ctrl-D on an empty line): leave the terminal on a new line.
       std::fputs("\n", m_opts.out);
@@ -126,6 +135,17 @@ class EditLineReader final : public LineReader {
     EditLineReader* self = nullptr;
     el_get(el, EL_CLIENTDATA, &self);
     return self->m_opts.prompt.data();
+  }
+
+  // Ctrl-C: "^C" where the cursor is (as the terminal echoes it for bash), a new line, and el_gets
+  // returns (read_line drops the line).
+  static unsigned char cancel(EditLine* el, int) {
+    EditLineReader* self = nullptr;
+    el_get(el, EL_CLIENTDATA, &self);
+    self->m_cancelled = true;
+    std::fputs("^C\n", self->m_opts.out);
+    std::fflush(self->m_opts.out);
+    return CC_NEWLINE;
   }
 
   static unsigned char complete(EditLine* el, int) {
@@ -221,6 +241,7 @@ class EditLineReader final : public LineReader {
   EditLine* m_el = nullptr;
   History* m_history = nullptr;
   bool m_history_failed = false;
+  bool m_cancelled = false;  // the line ended with Ctrl-C
 };
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "prizma/relight/terminal_preview.h"
@@ -251,8 +252,74 @@ std::string encode_kitty(const Rgb8Image& image) {
   return out;
 }
 
+ImageRoute image_route(ImageProtocol protocol, const TmuxFacts& tmux) {
+  ImageRoute route;
+  if (!tmux.inside || protocol == ImageProtocol::Blocks) return route;
+  if (protocol == ImageProtocol::Sixel && !tmux.sixel) {
+    route.shown = false;
+    route.why = "this tmux draws no sixel images (its device attributes lack sixel): a tmux built with sixel "
+                "(3.4 or later, configured with --enable-sixel) does, or run prizma-relight outside tmux; "
+                "'show blocks' draws here";
+  } else if (protocol == ImageProtocol::Kitty) {
+    route.shown = tmux.passthrough;
+    route.tmux_passthrough = tmux.passthrough;
+    if (!tmux.passthrough) {
+      route.why = "inside tmux, kitty graphics reach the terminal only through tmux's passthrough, which is off: "
+                  "run 'tmux set -g allow-passthrough on' (tmux 3.3 or later; the outer terminal must draw kitty "
+                  "graphics) and show kitty again; 'show blocks' draws here";
+    }
+  }
+  return route;
+}
+
+namespace {
+
+// What `command` (run by /bin/sh) writes on stdout, its end of line removed; empty when it fails.
+std::string command_output(const char* command) {
+  FILE* p = ::popen(command, "r");
+  if (!p) return {};
+  std::string out;
+  char buf[256];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+  if (::pclose(p) != 0) return {};
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out;
+}
+
+}  // namespace
+
+TmuxFacts tmux_facts(ImageProtocol protocol, int in_fd, int out_fd) {
+  TmuxFacts facts;
+  facts.inside = !TerminalEnvironment::from_process().tmux.empty();
+  if (!facts.inside) return facts;
+  if (protocol == ImageProtocol::Sixel) {
+    facts.sixel = query_image_protocol(in_fd, out_fd, 300, false) == ImageProtocol::Sixel;
+  } else if (protocol == ImageProtocol::Kitty) {
+    // A flag in tmux 3.3 (0 / 1), a choice in later ones (off / on / all).
+    const std::string v = command_output("tmux display-message -p '#{allow-passthrough}' 2>/dev/null");
+    facts.passthrough = v == "1" || v == "on" || v == "all" || v == "2";
+  }
+  return facts;
+}
+
+std::string tmux_passthrough(std::string_view escapes) {
+  std::string out;
+  while (!escapes.empty()) {
+    const std::size_t st = escapes.find("\x1b\\");
+    const std::size_t end = st == std::string_view::npos ? escapes.size() : st + 2;
+    out += "\x1bPtmux;";
+    for (const char c : escapes.substr(0, end)) {
+      if (c == '\x1b') out += '\x1b';
+      out += c;
+    }
+    out += "\x1b\\";
+    escapes.remove_prefix(end);
+  }
+  return out;
+}
+
 void draw_terminal_image(std::ostream& out, const std::vector<float>& rgb, int width, int height,
-                         ImageProtocol protocol, const TerminalSize& term, int reserved_rows) {
+                         ImageProtocol protocol, const TerminalSize& term, int reserved_rows, bool through_tmux) {
   if (protocol == ImageProtocol::Blocks) {
     print_terminal_thumbnail(out, rgb, width, height, term.columns, std::max(1, term.rows - reserved_rows));
     return;
@@ -260,7 +327,8 @@ void draw_terminal_image(std::ostream& out, const std::vector<float>& rgb, int w
   int w = 0, h = 0;
   fit_to_terminal(width, height, term, reserved_rows, w, h);
   const Rgb8Image small = resample_rgb8(rgb, width, height, w, h);
-  out << (protocol == ImageProtocol::Sixel ? encode_sixel(small) : encode_kitty(small)) << "\n" << std::flush;
+  const std::string escapes = protocol == ImageProtocol::Sixel ? encode_sixel(small) : encode_kitty(small);
+  out << (through_tmux ? tmux_passthrough(escapes) : escapes) << "\n" << std::flush;
 }
 
 }  // namespace prizma::relight

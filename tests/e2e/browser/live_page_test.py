@@ -12,7 +12,14 @@
                                               write the very same image; pages of other origins
                                               cannot use the server (cross_site.py)
 
-WORKDIR holds two.exr and one.exr (make_fixture). With --mri FILE (a render of data/scenes/mri.json,
+WORKDIR holds two.exr, one.exr and wide.exr (make_fixture); the browser test makes two_coef.exr and
+two_compact.exr from two.exr with `prizma-relight compress` (k = 5 of 16 bins), which the page relights
+from their coefficients and must match `prizma-relight` (without --exact) on. It also checks that the
+display is shown in its canvas colour space (Display P3: drawingBufferColorSpace 'display-p3';
+Rec.2020, which no canvas holds: Display P3 instead, said on the page, and the canvas then compared
+with the CLI's Display P3 image while Save writes Rec.2020), that every spectrum kind of a light shows
+its parameters at once and keeps them in the URL, and that the image, the controls and the probe's
+spectrum are all inside the window at 1400×900 and 1920×1080. With --mri FILE (a render of data/scenes/mri.json,
 lights key and env) the browser test also draws that real-data file in several states. With --fluor
 FILE (a small render of data/scenes/fluorescent_dye.json, lights key and sky: bispectral channels)
 it draws that file too (the re-radiation included, observers switched so that K is fetched again)
@@ -25,6 +32,7 @@ path may be long).
 import base64
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -166,6 +174,7 @@ def test_browser(relight, workdir, mri=None, fluor=None):
         webdriver = None
     if not chromium or not driver_path or webdriver is None:
         return missing_tool("chromium, chromium-driver or python3-selenium")
+    make_coefficient_files(relight, workdir)
     # The profile in a short temporary folder, not under the build folder: a clone's path may be long.
     with tempfile.TemporaryDirectory(prefix="plt-") as profile:
         opts = webdriver.ChromeOptions()
@@ -185,8 +194,27 @@ def test_browser(relight, workdir, mri=None, fluor=None):
     return 0
 
 
+def make_coefficient_files(relight, workdir):
+    """two_coef.exr (coefficients beside the bins) and two_compact.exr (coefficients only) from two.exr,
+    at a bound loose enough (ΔE00 5) that k = 5 of 16 and the compressed relight differs visibly from
+    the exact one: a page drawing the bins would fail the comparison."""
+    for name, extra in (("two_coef.exr", []), ("two_compact.exr", ["--compact"])):
+        run = subprocess.run([relight, "compress", os.path.join(workdir, "two.exr"), "-o", os.path.join(workdir, name),
+                              "--max-error", "5", "-q", *extra], capture_output=True, text=True)
+        if run.returncode != 0:
+            raise RuntimeError("prizma-relight compress: " + run.stderr.strip())
+
+
 DRAWN = "const c = document.getElementById('relit'); return [c.dataset.state, c.dataset.error || null, " \
         "Number(c.dataset.frame), location.hash];"
+
+# What the last frame shows: the display drawn, the canvas's colour space, the page's notice about it,
+# what it relit from, and the frame time it reports.
+SHOWN = """const c = document.getElementById('relit');
+const text = (id) => document.getElementById(id) ? document.getElementById(id).textContent : null;
+return [c.dataset.shownDisplay || null, c.getContext('webgl2').drawingBufferColorSpace || null, text('notice'),
+        c.dataset.transport || null, c.dataset.frameMs || null, text('frameinfo'), text('transport')];"""
+CANVAS_SPACE = {"sRGB": "srgb", "Display P3": "display-p3"}
 
 
 def open_page(browser, srv, state, joiner):
@@ -216,6 +244,12 @@ def check_pages(browser, relight, workdir, mri, fluor):
         ("two.exr", "light.side=LED-V1&light.back=D50&exposure=-0.3&cmf=2012-10&display=sRGB&adapt=0", "CIE 2012 10°"),
         ("one.exr", "light.key=D65&exposure=0&cmf=1931&display=sRGB&adapt=0", "a 1-bin file"),
         ("one.exr", "light.key=gaussian:550:40&exposure=1&cmf=2012-2&display=Display%20P3&adapt=1", "a 1-bin file, P3"),
+        ("two_coef.exr", "light.side=A&light.back=LED-B1*1.5&exposure=0.5&cmf=1931&display=sRGB&adapt=0",
+         "coefficients (k = 5 of 16): A and a blue LED"),
+        ("two_coef.exr", "light.side=F11&light.back=off&exposure=1&cmf=1964&display=Display%20P3&adapt=1",
+         "coefficients: F11 alone, 1964 observer, P3, adapted"),
+        ("two_compact.exr", "light.side=D65&light.back=A*2&exposure=0&cmf=1931&display=Rec.2020&adapt=0",
+         "a compact file (coefficients only), Rec.2020"),
     ]
     if mri:
         cases += [
@@ -248,21 +282,26 @@ def check_pages(browser, relight, workdir, mri, fluor):
             if drawn != state:
                 check(False, "%s: the page drew %r (error %r)" % (what, drawn, err))
                 continue
+            shown = check_shown(browser, name, state, what)
             w, h, data = browser.execute_script(READ_CANVAS)
             canvas = np.frombuffer(base64.b64decode(data), dtype=np.uint8).reshape(h, w, 4)[::-1, :, :3]
-            ref_path = os.path.join(workdir, "ref_%d.png" % len(refs))
-            run = subprocess.run([relight, os.path.join(workdir, name), *cli_args(state), "-o", ref_path],
-                                 capture_output=True, text=True)
-            if run.returncode != 0:
-                check(False, "%s: prizma-relight failed: %s" % (what, run.stderr.strip()))
+            ref = cli_image(relight, workdir, name, state, "ref_%d.png" % len(refs), what)
+            if ref is None:
                 continue
-            ref = read_png(ref_path)
             refs[state] = ref
-            diff = np.abs(canvas.astype(int) - ref.astype(int))
+            # The canvas against the CLI's image of the display it shows (the state's, or the one shown
+            # instead); Save against the state's.
+            drawn_ref = ref if shown == display_of(state) else cli_image(
+                relight, workdir, name, state, "ref_shown_%d.png" % len(refs), what, shown)
+            if drawn_ref is None:
+                continue
+            diff = np.abs(canvas.astype(int) - drawn_ref.astype(int))
             within = float(np.mean(np.all(diff <= TOLERANCE, axis=2)))
-            check(canvas.shape == ref.shape and within >= MIN_FRACTION,
-                  "%s: %.4f %% of pixels within %d/255 (max diff %d, mean %.3f, ref mean %.1f)" % (
-                      what, 100 * within, TOLERANCE, diff.max(), diff.mean(), ref.mean()))
+            check(canvas.shape == drawn_ref.shape and within >= MIN_FRACTION,
+                  "%s: %.4f %% of pixels within %d/255 of prizma-relight's %s image (max diff %d, mean %.3f, ref mean %.1f)" % (
+                      what, 100 * within, TOLERANCE, shown, diff.max(), diff.mean(), drawn_ref.mean()))
+            if name == "two_coef.exr" and name not in page_saved:
+                check_discriminates(relight, workdir, state, ref, what)
             # Save writes the exact CPU image: the page's own button for the first state of each file.
             if name not in page_saved:
                 page_saved.add(name)
@@ -283,9 +322,155 @@ def check_pages(browser, relight, workdir, mri, fluor):
         states = list(refs)
         check(len(states) >= 5 and not np.array_equal(refs[states[0]], refs[states[4]]) and refs[states[1]].max() == 0,
               "the references differ between states, all-off is black")
+        check_spectrum_menu(browser, servers["two.exr"])
+        servers["wide.exr"] = Server(relight, os.path.join(workdir, "wide.exr"), workdir)
+        for name in ["wide.exr"] + ([mri] if mri else []):
+            check_layout(browser, servers[name], name)
     finally:
         for srv in servers.values():
             check(srv.stop() == 0, "server for %s stopped cleanly" % srv.url)
+
+
+MENU_STATE = "light.side=D65&light.back=off&exposure=0&cmf=1931&display=sRGB&adapt=0"
+
+
+def check_spectrum_menu(browser, srv):
+    """Issue 25 item 1: choosing blackbody, gaussian or "other spec…" in a light's spectrum menu shows
+    that kind's parameter rows at once (and only those), and the spec, with what the rows then set,
+    goes into the URL and is drawn."""
+    from selenium.webdriver.support.ui import Select
+    open_page(browser, srv, MENU_STATE, "&")
+    fs = browser.find_element("css selector", "fieldset[data-light=side]")
+    rows = {f: fs.find_element("css selector", "[data-field=%s]" % f) for f in ("temp", "centre", "fwhm", "custom")}
+
+    def drawn_with(spec, what):
+        want = "light.side=" + spec
+        got = wait_for(browser, DRAWN, lambda r: r[0] and want + "&" in r[0] or r[1])
+        check(got[0] and want + "&" in got[0] and got[3].startswith("#" + want + "&"),
+              "%s: the URL and the drawn state hold %s (%r, error %r)" % (what, want, got[3], got[1]))
+
+    def set_row(field, value):
+        box = rows[field].find_element("css selector", "input[type=number], input[type=text]")
+        browser.execute_script("arguments[0].value = arguments[1]; arguments[0].dispatchEvent(new Event('change'));",
+                               box, value)
+
+    for kind, label, spec, visible, then in [
+        ("blackbody", "blackbody", "blackbody:3200K", {"temp"}, ("temp", "5600", "blackbody:5600K")),
+        ("gaussian", "gaussian", "gaussian:550:40", {"centre", "fwhm"}, ("fwhm", "25", "gaussian:550:25")),
+        ("custom", "other spec…", "gaussian:550:25", {"custom"}, ("custom", "box:500:560", "box:500:560")),
+    ]:
+        Select(fs.find_element("css selector", "select.kind")).select_by_visible_text(label)
+        shown = {f for f, row in rows.items() if row.is_displayed()}
+        check(shown == visible, "choosing %s shows its rows %s at once (shown: %s)" % (label, sorted(visible), sorted(shown)))
+        drawn_with(spec, "choosing " + label)
+        set_row(then[0], then[1])
+        drawn_with(then[2], "%s, its %s set to %s" % (label, then[0], then[1]))
+    # The URL's spec brings the menu and the rows back (a reload of the state-only address).
+    browser.refresh()
+    wait_for(browser, DRAWN, lambda r: r[2] >= 1 or r[1])
+    fs = browser.find_element("css selector", "fieldset[data-light=side]")
+    kind = Select(fs.find_element("css selector", "select.kind")).first_selected_option.text
+    text = fs.find_element("css selector", "[data-field=custom] input").get_attribute("value")
+    check(kind == "other spec…" and text == "box:500:560",
+          "a reload of the URL shows the spec in its row again (menu %r, spec %r)" % (kind, text))
+
+
+LAYOUT = """const r = (el) => { if (!el) return [-1, -1, -1, -1];  // missing: counted as outside
+  const b = el.getBoundingClientRect(); return [b.left, b.top, b.right, b.bottom]; };
+const q = (s) => Array.from(document.querySelectorAll(s));
+const c = document.getElementById('relit'), box = document.getElementById('stagebox');
+return {view: [window.innerWidth, window.innerHeight], dpr: window.devicePixelRatio,
+        parts: Object.fromEntries([['image', c], ['pixel spectrum plot', document.getElementById('probeplot')],
+                                   ['pixel read-out', document.getElementById('probe')],
+                                   ['A/B ΔE read-out', document.getElementById('compare')],
+                                   ['light spectra plot', document.getElementById('spectra')],
+                                   ['frame time', document.getElementById('frameinfo')]]
+                                  .concat(q('#panel fieldset').map((f, i) => ['controls ' + i, f]))
+                                  .map(([k, el]) => [k, r(el)])),
+        zoom: Number(c.dataset.zoom), size: [c.width, c.height], box: box ? [box.clientWidth, box.clientHeight] : [1, 1],
+        rendering: getComputedStyle(c).imageRendering};"""
+
+
+def check_layout(browser, srv, name):
+    """Issue 25 item 2: in a browser window of 1400×900 (a laptop screen; headless Chromium leaves a
+    1400×757 page inside it, as a browser with its tab and address bars does) and of 1920×1080, the
+    image, every control, the probe's spectrum plot, the A/B read-out and the frame time are inside the
+    page together; the image is as large as fits at a whole zoom (crisp, pixelated) for these small
+    files."""
+    browser.get(srv.url)  # the file's starting state
+    wait_for(browser, DRAWN, lambda r: r[2] >= 1 or r[1])
+    for width, height in ((1400, 900), (1920, 1080)):
+        browser.set_window_size(width, height)
+        wait_for(browser, "return [window.outerWidth, window.outerHeight];", lambda g: g == [width, height])
+        lay = wait_for(browser, "return (" + "() => {" + LAYOUT + "})();",
+                       lambda l: (l["zoom"] or 0) >= 1 and (l["zoom"] + 1) * max(l["size"][0] / max(l["box"][0], 1),
+                                                                           l["size"][1] / max(l["box"][1], 1)) > l["dpr"])
+        vw, vh = lay["view"]
+        outside = [k for k, (l, t, r, b) in lay["parts"].items() if l < 0 or t < 0 or r > vw + 0.5 or b > vh + 0.5]
+        check(vw == width and vh >= 0.8 * height and not outside,
+              "%s in a %d×%d window (page %d×%d): image, controls, probe plot and read-outs all inside (outside: %s %r)" % (
+                  name, width, height, vw, vh, outside or "none", lay["parts"] if outside else ""))
+        w, h = lay["size"]
+        zoom, (bw, bh) = lay["zoom"] or 0, lay["box"]
+        fits = zoom * w <= bw * lay["dpr"] + 0.5 and zoom * h <= bh * lay["dpr"] + 0.5
+        larger_fits = (zoom + 1) * w <= bw * lay["dpr"] and (zoom + 1) * h <= bh * lay["dpr"]
+        check(zoom == int(zoom) and zoom >= 2 and fits and not larger_fits and lay["rendering"] == "pixelated",
+              "%s at %d×%d: %d×%d image drawn at the largest whole zoom that fits its %d×%d box (%s×, %s)" % (
+                  name, width, height, w, h, bw, bh, zoom, lay["rendering"]))
+    browser.set_window_size(1400, 900)
+
+
+def display_of(state):
+    return dict(urllib.parse.parse_qsl(state))["display"]
+
+
+def cli_image(relight, workdir, name, state, out, what, display=None):
+    """prizma-relight FILE (the state's options; `display` instead of the state's when given) -o out:
+    the image read back, or None after a failed check."""
+    args = cli_args(state)
+    if display is not None:
+        args[args.index("--display") + 1] = display
+    path = os.path.join(workdir, out)
+    run = subprocess.run([relight, os.path.join(workdir, name), *args, "-o", path], capture_output=True, text=True)
+    if run.returncode != 0:
+        check(False, "%s: prizma-relight failed: %s" % (what, run.stderr.strip()))
+        return None
+    return read_png(path)
+
+
+def check_shown(browser, name, state, what):
+    """What the page says it drew: the state's display in its canvas colour space, or for Rec.2020 (no
+    canvas colour space holds it) Display P3 with a notice naming both; the transport it relit from;
+    its frame time. Returns the display shown."""
+    shown, space, notice, transport, frame_ms, frame_text, transport_text = browser.execute_script(SHOWN)
+    display = display_of(state)
+    if display == "Rec.2020":
+        check(shown == "Display P3" and space == "display-p3" and "Rec.2020" in notice and
+              "BT.2020 primaries" in notice and "Shown instead: Display P3" in notice and "Save writes Rec.2020" in notice,
+              "%s: no canvas holds Rec.2020: Display P3 shown (canvas %r) and said: %r" % (what, space, notice))
+    else:
+        check(shown == display and space == CANVAS_SPACE[display] and not notice,
+              "%s: %s drawn with drawingBufferColorSpace %r (got %r, %r), no notice (%r)" % (
+                  what, display, CANVAS_SPACE[display], shown, space, notice))
+    coefficients = name in ("two_coef.exr", "two_compact.exr")
+    check(transport == ("coefficients" if coefficients else "bins") and
+          (not coefficients or ("k = 5" in (transport_text or "") and "ΔE00 p99" in transport_text)),
+          "%s: relit from the %s, and the page says so (%r)" % (what, transport, transport_text))
+    check(frame_ms is not None and float(frame_ms) > 0 and frame_text is not None and re.match(r"frame [0-9.]+ ms \(relight", frame_text or ""),
+          "%s: the page shows its frame time (%r)" % (what, frame_text))
+    return shown
+
+
+def check_discriminates(relight, workdir, state, ref, what):
+    """The compressed relight differs from the exact one (--exact) by more than the tolerance on more
+    pixels than the comparison allows: a page drawing the bins would have failed it."""
+    import numpy as np
+    run = subprocess.run([relight, os.path.join(workdir, "two_coef.exr"), "--exact", *cli_args(state), "-o",
+                          os.path.join(workdir, "ref_exact.png")], capture_output=True, text=True)
+    exact = read_png(os.path.join(workdir, "ref_exact.png")) if run.returncode == 0 else None
+    off = float(np.mean(np.any(np.abs(exact.astype(int) - ref.astype(int)) > TOLERANCE, axis=2))) if exact is not None else 0
+    check(off > 1 - MIN_FRACTION, "%s: the bins' image differs from the coefficients' on %.1f %% of the pixels "
+          "(so the comparison tells them apart)" % (what, 100 * off))
 
 
 def save_from_page(browser, workdir, name):

@@ -2,7 +2,8 @@
 //   make_fixture DIR                 DIR/two.exr: 64×48, 16 bins 400–700 nm, lights "side" (default
 //                                    D65) and "back" (default A): the 24 ColorChecker patches, side
 //                                    rising left to right up to 1.4 (so bright patches clip), back a
-//                                    vertical ramp; DIR/one.exr: 64×48, 1 bin, one light
+//                                    vertical ramp; DIR/one.exr: 64×48, 1 bin, one light;
+//                                    DIR/wide.exr: 256×192, as two.exr (the page's layout check)
 //   make_fixture --size W H FILE     W×H, 16 bins, the same two lights (bench/live-page)
 #include <cmath>
 #include <filesystem>
@@ -78,6 +79,7 @@ int main(int argc, char** argv) {
     fs::create_directories(dir);
     write_spectral_exr(dir / "two.exr", two_lights(64, 48, 16));
     write_spectral_exr(dir / "one.exr", one_bin(64, 48));
+    write_spectral_exr(dir / "wide.exr", two_lights(256, 192, 16));
   } catch (const std::exception& e) {
     std::cerr << "make_fixture: " << e.what() << "\n";
     return 1;

@@ -113,7 +113,7 @@ def check_access(srv, save_dir):
         check(not os.path.exists(os.path.join(save_dir, "forged.png")), "%s %s: nothing saved yet" % (method, path))
         status = get(p, path, headers=page, method=method)
         check(status == 200, "%s %s as the page sends it: %d" % (method, path, status))
-    check(get(p, "/") == 200 and get(p, "/app.js") == 200 and get(p, "/state.js") == 200,
+    check(get(p, "/") == 200 and all(get(p, "/" + js) == 200 for js in ("state.js", "plots.js", "gpu.js", "app.js")),
           "the page and its scripts need no secret (they hold no data)")
     check(len(srv.refused()) >= len(API_ROUTES) * len(refused), "-v reports each refused request (%d lines)" %
           len(srv.refused()))

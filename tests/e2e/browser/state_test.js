@@ -74,3 +74,42 @@ test('query text: decoding and encoding', () => {
   assert.equal(S.stateValue(kStart, 'cmf=1964', 'cmf', '1931'), '1964');
   assert.equal(S.stateValue(kStart, '', 'display', 'x'), 'sRGB');
 });
+
+// Issue 25 item 1: choosing a kind in a light's spectrum menu shows that kind's parameter rows and
+// puts its spec into the URL; the URL's spec brings back the same menu entry and parameters.
+test('every spectrum kind: menu → controls → spec → controls (round trip), and its rows shown', () => {
+  const start = S.parseSpec('D65*0.5', kSpectra);
+  const want = {
+    'named:F11': { spec: 'F11*0.5', rows: [] },
+    blackbody: { spec: 'blackbody:3200K*0.5', rows: ['temp'] },
+    gaussian: { spec: 'gaussian:550:40*0.5', rows: ['centre', 'fwhm'] },
+    custom: { spec: 'D65*0.5', rows: ['custom'] },  // "other spec…" starts from the spec shown so far
+  };
+  for (const [value, w] of Object.entries(want)) {
+    const l = S.chooseKind(start, value);
+    assert.equal(S.kindValue(l), value);
+    assert.equal(S.specOf(l), w.spec, value);
+    const shown = Object.entries(S.fieldsOf(l.kind)).filter(([, on]) => on).map(([k]) => k);
+    assert.deepEqual(shown, w.rows, value);
+    // Through the URL and back: the same menu entry, the same spec.
+    const v = S.stateValues(kStart, 'light.side=' + S.enc(S.specOf(l)), ['side', 'back']);
+    const back = S.parseSpec(v.lights.side, kSpectra);
+    assert.equal(S.kindValue(back), value === 'custom' ? 'named:D65' : value);
+    assert.equal(S.specOf(back), w.spec);
+  }
+});
+
+test('a kind\'s parameters move with its sliders into the spec; switching kinds keeps them', () => {
+  let l = S.chooseKind(S.parseSpec('A', kSpectra), 'blackbody');
+  l = Object.assign(l, { temp: 5600 });
+  assert.equal(S.specOf(l), 'blackbody:5600K');
+  l = S.chooseKind(l, 'gaussian');
+  l = Object.assign(l, { centre: 610, fwhm: 25 });
+  assert.equal(S.specOf(l), 'gaussian:610:25');
+  l = S.chooseKind(l, 'blackbody');
+  assert.equal(S.specOf(l), 'blackbody:5600K');
+  l = S.chooseKind(l, 'custom');
+  assert.equal(S.specOf(l), 'blackbody:5600K');  // editable from there
+  l = S.chooseKind(S.parseSpec('off', kSpectra), 'gaussian');
+  assert.equal(l.on, true, 'choosing a spectrum switches an off light on');
+});

@@ -1,12 +1,16 @@
 #!/usr/bin/env python3
 """Checks that what a docs page says about its examples' results holds (run by run-doc after the
-page's blocks ran): check_docs.py PAGE RUN_DIR OUT_DIR. Exit 1 with one line per failed claim."""
+page's blocks ran): check_docs.py PAGE RUN_DIR OUT_DIR [PAGE.md]. Exit 1 with one line per failed
+claim. With PAGE.md, its colour claims (<!-- colour: … -->, colour_claims.py) are checked too,
+against the images the blocks wrote and those the page shows."""
 import os
 import re
 import sys
 
 import numpy as np
 import OpenImageIO as oiio
+
+import colour_claims
 
 failures = []
 
@@ -90,6 +94,10 @@ def user_guide(run, out):
           "side.exr is float R, G, B (linear sRGB): %s" % list(spec.channelnames))
     # Step 5: the metamer matches under D65 and differs under F11; the hiding light hides it.
     text = "\n".join(block(out, n) for n in range(1, 10) if os.path.exists(os.path.join(out, "block-%d.txt" % n)))
+    # Step 2: inspect shows the histogram and the voxels each material's range takes.
+    claim(re.search(r"histogram +4 bins over \[100, 255\]", text) is not None and
+          re.search(r"rayleigh +\[50, 150\] \(normalised [^)]*\): [0-9 ]+ voxels", text) is not None and
+          "no material:" in text, "prizma-render inspect lists the histogram and the voxels of rayleigh and sphere")
     rows = de00_rows(text.split("hiding light")[0])
     claim(rows.get("match D65", 99) < 0.5 and rows.get("split F11", 0) > 5,
           "the metamer: dE00 %.2f under D65, %.2f under F11" % (rows.get("match D65", -1), rows.get("split F11", -1)))
@@ -127,9 +135,33 @@ def metamerism(run, out):
         claim(d < 0.5 and ref > d, "hiding light: dE00 %.3f, under the reference A %.2f" % (d, ref))
 
 
+def relight(run, out):
+    for f in ("cs.exr", "relight_cs_side.png", "relight_cs_back.png", "relight_cs_mixed.png", "cc.exr", "relight_d65.png",
+              "relight_a.png", "relight_a_adapt.png", "relight_f11.png", "relight_rim.png", "relight_narrow.png", "a.png",
+              "cc_coef.exr", "cc_compact.exr", "relight_compact.png"):
+        claim(os.path.isfile(os.path.join(run, f)), "the examples wrote " + f)
+    # The interactive session's numbers, as the page prints them (the chart is synthetic: exact).
+    text = "\n".join(block(out, n) for n in range(1, 10) if os.path.exists(os.path.join(out, "block-%d.txt" % n)))
+    # (to the 6th decimal ± 2: the page's numbers are of an earlier build, float sums may differ in the last digit)
+    for key, want in (("XYZ", [0.953604, 0.869455, 0.306993]), ("dE2000", [14.516177])):
+        m = re.search(r"^  %s ((?:[-0-9.]+ ?)+)$" % key, text, re.M)
+        got = [float(v) for v in m.group(1).split()] if m else []
+        claim(len(got) == len(want) and all(abs(g - w) <= 2e-6 for g, w in zip(got, want)),
+              "the session prints %s %s (the page: %s)" % (key, got, want))
+    m = re.search(r"^key: k = (\d+) of 32 bins", text, re.M)
+    claim(m is not None and m.group(1) == "14", "compress keeps k = 14 of 32 bins for the key light (got %s)" %
+          (m.group(1) if m else "no line"))
+
+
 def main():
     page, run, out = sys.argv[1:4]
-    {"user-guide": user_guide, "metamerism": metamerism}[page](run, out)
+    {"user-guide": user_guide, "metamerism": metamerism, "relight": relight}[page](run, out)
+    if len(sys.argv) > 4:
+        results = colour_claims.Results()
+        docs_dir = os.path.dirname(os.path.abspath(sys.argv[4]))
+        n = colour_claims.check_claims(sys.argv[4], docs_dir, run, results)
+        failures.extend(results.failures)
+        print("%d colour claims checked" % n)
     if failures:
         print("%d claim(s) of %s.md do not hold" % (len(failures), page))
         sys.exit(1)

@@ -3,15 +3,20 @@
 keys go in with send-keys, the screen comes back with capture-pane. Checks line editing (Up recalls
 the last command), Tab completion (a light name; a display name with a blank, quoted), history kept
 across sessions in $XDG_STATE_HOME/prizma/relight_history, status, adapt, undo, show, the pixel-index
-errors, and that a history that cannot be written, or is not libedit's, is only a warning.
+errors, and that a history that cannot be written, or is not libedit's, is only a warning. A fifth
+session checks the keys and commands of issue 25 item 17: Ctrl-C cancels the line being typed (not
+run, not in the history) and, on an empty line too, never ends the session; `clear` clears the
+screen; `show kitty` and `show sixel` inside tmux say what tmux needs instead of reporting "drawn"
+with nothing on the screen, and kitty goes through tmux's passthrough once it is allowed; Ctrl-D ends
+the session.
 
 Every wait polls the screen until the expected text is there, with a bound (TIMEOUT_S); the tmux
 server is killed at the end whatever happened.
 
-With --mri FILE a fifth session runs on that file (a render of data/scenes/mri.json): light names
+With --mri FILE a sixth session runs on that file (a render of data/scenes/mri.json): light names
 completed from its layers (key, env), a light changed and switched off, a probe, a show.
 
-With --fluor FILE (a small render of data/scenes/fluorescent_dye.json, bispectral channels) a sixth
+With --fluor FILE (a small render of data/scenes/fluorescent_dye.json, bispectral channels) a seventh
 session probes a pixel of the dyed sphere: the excitation-emission map of each light, and of one light
 named after the coordinates, with its largest value as the digit 9.
 
@@ -66,6 +71,10 @@ class Pane:
     def screen(self):
         return self.tmux("capture-pane", "-p", "-J", "-S", "-5000", "-t", self.target)
 
+    def visible(self):
+        """The pane as it is on the screen now (no scrollback)."""
+        return self.tmux("capture-pane", "-p", "-J", "-t", self.target)
+
     def lines(self):
         return [l.rstrip() for l in self.screen().split("\n")]
 
@@ -116,6 +125,55 @@ def expect(cond, message, screen=""):
 def session_command(exe, scene, env):
     assigns = " ".join(f"{k}={shlex.quote(v)}" for k, v in env.items())
     return f"env -u PRIZMA_TERMINAL_IMAGES -u KITTY_WINDOW_ID {assigns} {shlex.quote(exe)} {shlex.quote(scene)} -i"
+
+
+def tmux_version(pane):
+    m = re.search(r"([0-9]+)\.([0-9]+)", subprocess.run(["tmux", "-V"], capture_output=True, text=True).stdout)
+    return (int(m[1]), int(m[2])) if m else (0, 0)
+
+
+def session_keys(pane, exe, scene, env, history):
+    """Session 5 (issue 25 item 17): Ctrl-C, clear, show inside tmux, Ctrl-D."""
+    pane.start(session_command(exe, scene, env))
+    pane.wait_prompt(1)
+    # Ctrl-C cancels the line being typed: nothing runs, a new prompt, as in bash.
+    pane.type("exposure 3")
+    pane.wait("the typed line", lambda s: pane.last_line() == f"{PROMPT} exposure 3")
+    pane.key("C-c")
+    screen = pane.wait_prompt(2)
+    expect(f"{PROMPT} exposure 3^C" in screen, "Ctrl-C did not cancel the line with ^C", screen)
+    # … and on an empty line it does not end the session either.
+    pane.key("C-c")
+    screen = pane.wait_prompt(3)
+    expect(f"{PROMPT} ^C" in screen and "[exited" not in screen, "Ctrl-C on an empty line ended the session", screen)
+    screen = pane.command("status")
+    expect("exposure    0 EV" in screen and "undo        0 levels" in screen,
+           "the cancelled line ran (status after Ctrl-C)", screen)
+    with open(history, encoding="utf-8", errors="replace") as f:
+        expect("exposure 3" not in f.read(), "the cancelled line went into the history")
+    # clear: only the prompt is left on the screen (the output before it is gone from view).
+    pane.type("clear")
+    pane.key("Enter")
+    pane.wait("the screen cleared", lambda s: [l.rstrip() for l in pane.visible().split("\n") if l.strip()] == [PROMPT])
+    # show kitty / sixel inside tmux: not "drawn" with nothing on the screen, but what tmux needs.
+    screen = pane.command("show kitty")
+    tail = screen[screen.rfind(f"{PROMPT} show kitty"):]
+    expect("error: show kitty: inside tmux" in tail and "tmux set -g allow-passthrough on" in tail and "drawn" not in tail,
+           "show kitty inside tmux (passthrough off) did not say what to do", tail)
+    if tmux_version(pane) < (3, 4):  # no sixel in tmux before 3.4
+        screen = pane.command("show sixel")
+        tail = screen[screen.rfind(f"{PROMPT} show sixel"):]
+        expect("error: show sixel: this tmux draws no sixel images" in tail and "drawn" not in tail,
+               "show sixel inside a tmux without sixel did not say so", tail)
+    pane.tmux("set-option", "-g", "allow-passthrough", "on")
+    screen = pane.command("show kitty")
+    tail = screen[screen.rfind(f"{PROMPT} show kitty"):]
+    expect("through tmux's passthrough" in tail and re.search(r"drawn in [0-9.]+ ms", tail) and "error" not in tail,
+           "show kitty with passthrough allowed was not drawn through it", tail)
+    pane.tmux("set-option", "-g", "allow-passthrough", "off")
+    # Ctrl-D on an empty line ends the session (exit 0).
+    pane.key("C-d")
+    pane.wait("Ctrl-D to end the session", lambda s: "[exited 0]" in s)
 
 
 def main():
@@ -250,8 +308,9 @@ def main():
         pane.wait("the fourth session to end", lambda s: "[exited 0]" in s)
         with open(foreign) as f:
             expect(f.read() == "my own notes\n", "the foreign history file was overwritten")
+        session_keys(pane, exe, scene, env, history)
         if mri:
-            # Session 5: the MRI render, through the same keys.
+            # Session 6: the MRI render, through the same keys.
             pane.start(session_command(exe, mri, env))
             screen = pane.wait_prompt(1)
             expect("relit in " in screen and "error" not in screen, "the MRI file did not open", screen)
@@ -273,7 +332,7 @@ def main():
             pane.key("Enter")
             pane.wait("the MRI session to end", lambda s: "[exited 0]" in s)
         if fluor:
-            # Session 6: a fluorescent render, the pixel probe's excitation-emission map.
+            # Session 7: a fluorescent render, the pixel probe's excitation-emission map.
             pane.start(session_command(exe, fluor, env))
             screen = pane.wait_prompt(1)
             expect("relit in " in screen and "error" not in screen, "the fluorescent file did not open", screen)

@@ -35,7 +35,18 @@ struct PictureColourSpace {
   int curve_type = 4;
   std::array<double, 5> curve_parameters{2.4, 1.0 / 1.055, 0.055 / 1.055, 1.0 / 12.92, 0.04045};
   std::vector<float> curve_table;
+  // ITU-T H.273 code points {colour primaries, transfer characteristics, matrix coefficients, full
+  // range}, written into a PNG as its cICP chunk (PNG 3rd edition), which readers that know it take
+  // before the ICC profile; unset when H.273 has no code for the space (cicp_code_points).
+  std::optional<std::array<std::uint8_t, 4>> cicp;
 };
+
+// The H.273 code points of a colour space, when its primaries and white are within 0.002 in xy of a
+// coded set (1 BT.709 / sRGB, 9 BT.2020, 12 P3-D65: SMPTE EG 432-1) and its curve is one H.273
+// codes: the sRGB piecewise curve (13), a 2.2 power (4), a 2.4 power (1: BT.709 / BT.2020, whose
+// reference display is BT.1886, a 2.4 power with black at 0; ITU-T H-series Supplement 19). Matrix
+// 0 (RGB), full range 1. Nothing for a table curve or other primaries.
+std::optional<std::array<std::uint8_t, 4>> cicp_code_points(const PictureColourSpace& cs);
 
 struct PictureSpec {
   int width = 0;
@@ -45,7 +56,10 @@ struct PictureSpec {
   std::vector<std::string> channel_names;                       // empty: OpenImageIO's default (R, G, B, …)
   std::vector<std::pair<std::string, std::string>> attributes;  // string metadata, e.g. {"compression", "zip"}
   std::vector<std::pair<std::string, std::vector<float>>> float_attributes;  // e.g. {"chromaticities", 8 floats}
-  std::optional<PictureColourSpace> colour_space;  // PNG, TIFF, JPEG: embedded as an ICC profile (other formats have no place for one)
+  // PNG, TIFF, JPEG: embedded as an ICC profile (other formats have no place for one), and in a PNG
+  // its cICP chunk; a JPEG also gets the Exif ColorSpace tag: 1 (sRGB) for cICP primaries 1 with
+  // transfer 13, else 0xFFFF (Uncalibrated: "not sRGB, see the profile", Exif 2.32 §4.6.5).
+  std::optional<PictureColourSpace> colour_space;
 };
 
 // Writes one picture into `out` (write_atomically's checked temporary), the format chosen by
@@ -81,7 +95,8 @@ namespace image_io_module {
 
 // What the module exports: extern "C" const Module* prizma_image_io_module_v1(). Compiled with
 // the same compiler and library as the tools (it is built with them), so C++ types cross.
-constexpr int kAbiVersion = 3;  // 2: PictureSpec::float_attributes; 3: PictureSpec::colour_space
+// 2: PictureSpec::float_attributes; 3: PictureSpec::colour_space; 4: PictureColourSpace::cicp
+constexpr int kAbiVersion = 4;
 constexpr const char* kEntryPoint = "prizma_image_io_module_v1";
 
 // The bytes of the file being written (an AtomicOutput, adapted by the tool's side). Never throws.

@@ -31,6 +31,9 @@ struct LightRecord {
   bool operator==(const LightRecord&) const = default;
 };
 
+// A record of a name and a spectrum spec, nothing else set (a relit image's lights, tests).
+LightRecord light_record(std::string name, std::string spectrum = {});
+
 // Parses prizma:lights: a JSON array of objects with the fields above (unknown fields are ignored,
 // absent ones stay unset). Throws InputError(input, …) for text that is not JSON, nested deeper than
 // 128 levels, not an array of objects, or with a field of the wrong type, naming the entry.

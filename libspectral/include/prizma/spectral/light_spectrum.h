@@ -24,12 +24,24 @@ struct LightSpectrum {
   Spectrum spectrum;         // the spectrum without the trailing scale
   double scale = 1.0;        // trailing "*<factor>" factors, applied after normalisation
   bool off = false;          // "off" (or scale 0): the light contributes nothing
+  bool scaled = false;       // the spec says its scale: trailing factors, or "off"
 };
 
 // Parses "off", or any parse_spectrum spec with optional trailing "*<factor>" scales. Throws
 // InputError naming ctx.input for bad specs, negative / non-finite scales, or a scale (the factors'
 // product) above kMaxLightScale.
 LightSpectrum parse_light_spectrum(std::string_view text, const SpecContext& ctx = {});
+
+// The product of the trailing "*<factor>" factors of a light spec (1 without any; 0 for "off"),
+// without reading the spectrum itself. Throws InputError as parse_light_spectrum does for a bad factor.
+double light_spec_scale(std::string_view text, const SpecContext& ctx = {});
+
+// One spectrum given for every light at once (`--light F11`, a batch file's "lights": "F11", the
+// shell's `light F11`, prizma.relight(lights="F11")) as light `current_scale` receives it: a spec
+// that says its scale (trailing factors, "off") as it is; a bare one at the light's scale, so the
+// scene's balance between its lights holds (a sky at "D65*0.2" becomes "F11*0.2") and a light that
+// is off (scale 0) stays off. The text records the scale given ("F11*0.2"). docs/relight.md.
+LightSpectrum at_light_scale(const LightSpectrum& given, double current_scale);
 
 // relight_weights() of the bare spectrum times the scale; a zero matrix for a light that is off.
 Eigen::Matrix<double, 3, Eigen::Dynamic> relight_weights(const ColorMatching& cmf, const LightSpectrum& light,

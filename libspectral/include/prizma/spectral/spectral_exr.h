@@ -27,6 +27,9 @@ struct SpectralExrInfo {
   std::string scene_path;        // prizma:scenePath, the scene file (absolute) the render read
   std::string render_options;    // prizma:renderOptions (JSON object: the command-line overrides)
   bool is_prizma = false;        // read: the file carried prizma: attributes
+  // Read: what the reader inferred or adjusted that a careful user may want to know (an inferred bin
+  // edge clamped to the colour matching tables); the tools print these with -v. Never written.
+  std::vector<std::string> notes;
 };
 
 // How well a layer's k-term spectral-basis reconstruction relights under one test light

@@ -81,6 +81,11 @@ struct CompressFileOptions {
 CompressedTransport compress_spectral_exr(const std::filesystem::path& input, const std::filesystem::path& output,
                                           const CompressFileOptions& options);
 
+// The weights relight_compressed_into multiplies each light's coefficients by: W_l = M_l·B_l, 3×k_l
+// as float, row-major (X, Y, Z rows); empty for a light that is off. The live page's shader uses these
+// very numbers. Throws as relight_compressed_into when the matrix does not match the transport.
+std::vector<std::vector<float>> coefficient_weights(const CompressedTransport& transport, const spectral::RelightMatrix& matrix);
+
 // XYZ = Σ_l (M_l·B_l)·c_l for every pixel (TBB over rows; independent of the thread count). Throws
 // RuntimeError when the matrix does not match the transport's lights or bins, or a layer's sizes
 // are inconsistent.

@@ -88,7 +88,13 @@ class RelightSession {
   // Replaces every setting at once; validates (RelightSettings::validate with `names`, then builds the
   // matrix and display) before committing, so a failure leaves the session as it was.
   void apply(RelightSettings settings, const RelightSettingNames& names = {});
-  // Convenience setters (same all-or-nothing rule). An empty name sets every layer.
+  // Sets `given` on every layer of `lights` (settings().lights, or settings being built from them),
+  // as every all-lights form means it (--light SPEC, a batch file's "lights": "SPEC", the shell's
+  // `light SPEC`, prizma.relight(lights=SPEC)): a spec that says its scale as it is, a bare one at
+  // each layer's scale in `lights` (spectral::at_light_scale: a light that is off stays off; a
+  // recorded spectrum that cannot be read here lends the factors it was recorded with).
+  void set_every_light(std::vector<LightSpec>& lights, const LightSpec& given) const;
+  // Convenience setters (same all-or-nothing rule). An empty name sets every layer (set_every_light).
   void set_light(std::string_view name, std::string_view spec);
   void set_exposure(double exposure_ev);
   void set_cmf(spectral::Observer cmf);

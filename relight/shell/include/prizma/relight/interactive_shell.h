@@ -2,7 +2,8 @@
 // The interactive command loop of prizma-relight -i, reading commands from a LineReader: a terminal
 // with line editing, history and completion, or any stream (a pipe, a file, a test's string).
 //   light NAME SPEC | light SPEC   exposure EV   cmf NAME   display NAME   adapt on|off   undo
-//   status   lights   show [PROTOCOL]   save FILE   probe X Y   compare X1 Y1 X2 Y2 [R]   help   quit
+//   status   lights   show [PROTOCOL]   save FILE   probe X Y   compare X1 Y1 X2 Y2 [R]   clear   help
+//   quit
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -29,6 +30,10 @@ struct InteractiveOptions {
   // The window to fit images to: `terminal_size`, when set, is asked at every drawing; else `terminal`.
   TerminalSize terminal;
   std::function<TerminalSize()> terminal_size;
+  // Asked before every sixel or kitty drawing, when set: whether it would reach the screen (inside
+  // tmux: image_route, terminal_image.h); a drawing that would not is an error saying what to do.
+  std::function<ImageRoute(ImageProtocol)> image_route;
+  bool terminal_output = false;   // `out` is a terminal: `clear` clears it (else `clear` writes nothing)
   std::size_t undo_levels = 100;  // changes `undo` can take back
 };
 

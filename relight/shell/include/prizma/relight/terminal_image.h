@@ -51,6 +51,30 @@ ImageProtocol query_image_protocol(int in_fd, int out_fd, int timeout_ms = kTerm
 // query, which tmux would take for a window title).
 ImageProtocol detect_image_protocol(int in_fd, int out_fd);
 
+// Whether an image drawn with a protocol reaches the screen, and how. Inside tmux (TMUX set) tmux
+// draws the pane itself: sixel images only when tmux was built with sixel (3.4 or later, configured
+// with --enable-sixel; it then answers the device-attributes query with attribute 4), kitty graphics
+// only through tmux's passthrough (allow-passthrough on, tmux 3.3 or later), each escape wrapped for
+// it. Outside tmux, and half blocks everywhere, images go as they are.
+struct TmuxFacts {
+  bool inside = false;       // TMUX is set
+  bool sixel = false;        // tmux answered DA1 with attribute 4
+  bool passthrough = false;  // allow-passthrough is on (or all) for this pane
+};
+struct ImageRoute {
+  bool shown = true;              // false: nothing would appear on the screen; `why` says what to do
+  bool tmux_passthrough = false;  // send the escapes through tmux's passthrough (tmux_passthrough())
+  std::string why;
+};
+ImageRoute image_route(ImageProtocol protocol, const TmuxFacts& tmux);
+// The facts for this process: TMUX from the environment; inside tmux only, and only what `protocol`
+// needs, tmux's answer to DA1 on the terminal (in_fd, out_fd: query_image_protocol) or
+// `tmux display-message -p '#{allow-passthrough}'` (tmux found through TMUX, as every tmux client).
+TmuxFacts tmux_facts(ImageProtocol protocol, int in_fd, int out_fd);
+// Escape sequences, each ending in ST (ESC \), wrapped one by one in tmux's passthrough:
+// ESC P tmux; <the sequence with every ESC doubled> ESC \ (one at a time: tmux limits a sequence's size).
+std::string tmux_passthrough(std::string_view escapes);
+
 // An interleaved 8-bit RGB image.
 struct Rgb8Image {
   int width = 0, height = 0;
@@ -68,8 +92,10 @@ void fit_to_terminal(int width, int height, const TerminalSize& term, int reserv
 std::string encode_sixel(const Rgb8Image& image);  // DCS … ST, 256 colours; throws RuntimeError if libsixel fails
 std::string encode_kitty(const Rgb8Image& image);  // APC G chunks (f=24, a=T, q=2: no replies), base64
 
-// Draws the image sized to the terminal with the protocol, and a newline after it.
+// Draws the image sized to the terminal with the protocol, and a newline after it; sixel and kitty
+// escapes through tmux's passthrough when `through_tmux`.
 void draw_terminal_image(std::ostream& out, const std::vector<float>& rgb, int width, int height,
-                         ImageProtocol protocol, const TerminalSize& term, int reserved_rows = 3);
+                         ImageProtocol protocol, const TerminalSize& term, int reserved_rows = 3,
+                         bool through_tmux = false);
 
 }  // namespace prizma::relight
