@@ -1,5 +1,6 @@
 // The scene's camera (docs/scene-format.md, "Camera"): perspective or orthographic, where it stands
 // and looks, its field of view and the image size.
+#include <Eigen/Geometry>  // cross()
 #include <cmath>
 
 #include "scene_reader.h"

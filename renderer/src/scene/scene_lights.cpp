@@ -72,7 +72,8 @@ void read_spot(const Reader& rd, const json& sj, const std::string& sp, Light& l
 // and spot lights").
 void read_point_light(const Reader& rd, const json& lj, const std::string& lp, Light& l) {
   if (lj.contains("environment")) rd.fail(Reader::join(lp, "environment"), "does not apply to a light with position (a light has one of direction, position and environment)");
-  if (lj.contains("rotation_deg")) rd.fail(Reader::join(lp, "rotation_deg"), "applies to environment-map lights only (this light has a position)");
+  for (const char* key : {"rotation_deg", "convention"})
+    if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to environment-map lights only (this light has a position)");
   const std::string pp = Reader::join(lp, "position");
   const auto p = rd.vec3(lj.at("position"), pp);
   for (int a = 0; a < 3; ++a)
@@ -89,7 +90,10 @@ void read_point_light(const Reader& rd, const json& lj, const std::string& lp, L
   if (lj.contains("spot")) read_spot(rd, lj.at("spot"), Reader::join(lp, "spot"), l);
 }
 
-// An environment-map light ("environment"), with its rotation (docs/scene-format.md, "Environment maps").
+// An environment-map light's fields: the image, its convention and rotation (docs/scene-format.md,
+// "Environment maps"). A square image must say its convention: it is pbrt-v4's equal-area layout as
+// often as a latitude–longitude map of an unusual shape, and read as the wrong one every direction
+// is wrong.
 void read_environment_map(const Reader& rd, const json& lj, const std::string& lp, Light& l) {
   for (const char* key : {"radius", "spot"})
     if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to point lights only (this light is an environment map)");
@@ -99,9 +103,18 @@ void read_environment_map(const Reader& rd, const json& lj, const std::string& l
     l.rotation_deg = rd.number(lj.at("rotation_deg"), rp);
     if (!(std::abs(l.rotation_deg) <= 360.0)) rd.fail(rp, "must be in [-360, 360] (got " + num(l.rotation_deg) + ")");
   }
+  const std::string cp = Reader::join(lp, "convention");
+  std::optional<EnvironmentConvention> convention;
+  if (lj.contains("convention")) convention = parse_environment_convention(rd.string(lj.at("convention"), cp), rd.input(cp));
   l.environment_file = rd.string(lj.at("environment"), ep);
-  l.environment_map = std::make_shared<const EnvironmentMap>(
-      EnvironmentMap::load(rd.file_path(lj.at("environment"), ep), l.rotation_deg, rd.input(ep)));
+  l.environment_map = std::make_shared<const EnvironmentMap>(EnvironmentMap::load(
+      rd.file_path(lj.at("environment"), ep), l.rotation_deg, rd.input(ep), convention.value_or(EnvironmentConvention::Prizma)));
+  const EnvironmentMap& map = *l.environment_map;
+  if (!convention && map.width() == map.height() && map.width() > 1) {
+    rd.fail(cp, "is required for the square image " + l.environment_file + " (" + std::to_string(map.width()) + "×" +
+                    std::to_string(map.height()) + "): \"pbrt-equal-area\" for pbrt-v4's equal-area map, or " +
+                    "\"prizma\" or \"mitsuba\" for a latitude–longitude map");
+  }
 }
 
 // A directional light, or the uniform environment (direction [0, 0, 0]).
@@ -123,8 +136,8 @@ void read_directional_light(const Reader& rd, const json& lj, const std::string&
   }
   for (const char* key : {"radius", "spot"})
     if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to point lights only (give position, not direction)");
-  if (lj.contains("rotation_deg"))
-    rd.fail(Reader::join(lp, "rotation_deg"), "applies to environment-map lights only (give environment, not direction)");
+  for (const char* key : {"rotation_deg", "convention"})
+    if (lj.contains(key)) rd.fail(Reader::join(lp, key), "applies to environment-map lights only (give environment, not direction)");
 }
 
 }  // namespace
@@ -139,7 +152,7 @@ std::vector<Light> read_lights(const Reader& rd, const json& j) {
     const std::string lp = Reader::index(path, i);
     const json& lj = j[i];
     rd.expect_object(lj, lp, {"name", "direction", "spectrum", "angular_size_deg", "position", "radius", "spot",
-                              "environment", "rotation_deg"});
+                              "environment", "rotation_deg", "convention"});
     Light l;
     const std::string np = Reader::join(lp, "name");
     if (!lj.contains("name")) rd.fail(np, "is required");

@@ -2,9 +2,12 @@
 // its own reader (scene_reader.h), the cheap sections first so that a typo is reported before a
 // large volume is read.
 #include <algorithm>
+#include <cctype>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
+#include "prizma/render/volume_inspection.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "scene_hash.h"
@@ -118,6 +121,42 @@ Scene load_scene(const std::filesystem::path& path, const std::vector<SceneOverr
   std::stringstream buffer;
   buffer << in.rdbuf();
   return scene_from_text(buffer.str(), file, path, overrides);
+}
+
+InspectedVolume load_for_inspection(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  spectral::require_regular_file(path, "a scene or volume file");
+  InspectedVolume out;
+  out.input = file;
+  std::string name = path.filename().string();
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+  const auto ends = [&](const char* e) { return name.size() >= std::strlen(e) && name.compare(name.size() - std::strlen(e), std::string::npos, e) == 0; };
+  if (ends(".json")) {
+    // The scene's volume and transfer function, read by the loader's own functions.
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    const json root = scene_file::parse_json(buffer.str(), file);
+    const Reader rd(file, path.parent_path());
+    if (!root.is_object() || !root.contains("volume")) rd.fail("volume", "is required");
+    out.volume = scene_file::read_volume(rd, root.at("volume"));
+    out.from_scene = true;
+    out.normalisation_given = (root.contains("normalisation") && root.at("normalisation").is_object()) ||
+                              (root.contains("normalization") && root.at("normalization").is_object());
+    out.normalisation = scene_file::read_normalisation(rd, root, out.volume);
+    if (root.contains("materials")) out.transfer = scene_file::read_materials(rd, root.at("materials"), out.normalisation);
+    else if (root.contains("transfer_function")) out.transfer = scene_file::read_tf_image(rd, root.at("transfer_function"), out.normalisation);
+    return out;
+  }
+  // A volume file: the "volume" a scene would give for it.
+  const char* type = ends(".nii") || ends(".nii.gz") ? "nifti" : ends(".raw") ? "raw" : ends(".vdb") ? "vdb" : nullptr;
+  if (type == nullptr) {
+    throw InputError(file, "not a scene or volume file this can inspect (known: .json, .nii, .nii.gz, .raw, .vdb)");
+  }
+  const Reader rd("", std::filesystem::path());  // the path as given: the loaders' messages name it so
+  out.volume = scene_file::read_volume(rd, json{{"type", type}, {"path", file}});
+  out.normalisation = auto_normalisation(out.volume);
+  return out;
 }
 
 Scene load_scene_text(const std::string& text, const std::string& input, const std::filesystem::path& base_dir,
