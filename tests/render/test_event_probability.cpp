@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <iomanip>
+#include <limits>
 #include <vector>
 
 #include "prizma/render/event_probability.h"
@@ -80,9 +81,20 @@ TEST(EventProbability, AutoRuleReadsTheSpectra) {
   auto c = choose(grey_material(0.8, 5.0));
   EXPECT_EQ(c.scheme, EventProbabilities::Implicit);
   EXPECT_DOUBLE_EQ(c.albedo_max, 0.8);
-  // Chromatic extinction (the Rayleigh-like cube): implicit.
+  EXPECT_EQ(c.extinction_ratio, 1.0);
+  // Chromatic extinction (the Rayleigh-like cube): implicit. σt linear 9 → 1 over 12 bins of 25 nm:
+  // bin averages 9 − 8·(12.5/300) = 26/3 in the first and 1 + 8·(12.5/300) = 4/3 in the last, ratio
+  // 6.5 (what the wavelength-sampling rule reads against kMisExtinctionRatio).
   c = choose(make_material(Spectrum::constant(0.99), Spectrum({400.0, 700.0}, {9.0, 1.0}), Spectrum::constant(0.0)));
   EXPECT_EQ(c.scheme, EventProbabilities::Implicit);
+  EXPECT_NEAR(c.extinction_ratio, 6.5, 1e-12);
+  // No extinction in some bin: an infinite ratio; none anywhere: 1 (nothing to sample), albedo max 0.
+  c = choose(make_material(Spectrum::constant(0.5), Spectrum({400.0, 550.0, 551.0, 700.0}, {0.0, 0.0, 2.0, 2.0}),
+                           Spectrum::constant(0.0)));
+  EXPECT_EQ(c.extinction_ratio, std::numeric_limits<double>::infinity());
+  c = choose(make_material(Spectrum::constant(0.5), Spectrum::constant(0.0), Spectrum::constant(0.0)));
+  EXPECT_EQ(c.extinction_ratio, 1.0);
+  EXPECT_EQ(c.albedo_max, 0.0);
   // Saturated albedo (the metamer spheres): implicit.
   c = choose(make_material(Spectrum({400.0, 550.0, 700.0}, {0.05, 0.9, 0.1}), Spectrum::constant(40.0),
                            Spectrum::constant(0.0)));
@@ -102,14 +114,15 @@ TEST(EventProbability, AutoRuleReadsTheSpectra) {
 }
 
 TEST(EventProbability, TheLogNamesWhatDecided) {
-  // -v prints each material's scheme and the one measure the rule decided by (the extinction ratio
-  // and the albedo spread were printed too, and decided nothing).
+  // -v prints each material's scheme and the measures the auto rules decide by: the albedo max (the
+  // event scheme) and the extinction ratio (the wavelength sampling); the albedo spread, printed
+  // once, decided nothing and is gone.
   std::vector<Material> materials{grey_material(0.8, 5.0), grey_material(0.25, 2.0)};
   materials[0].name = "fog";
   materials[1].name = "soot";
   const auto bins = spectral::BinLayout::linear(400, 700, 4);
   EXPECT_EQ(describe_event_probabilities(choose_event_probabilities(EventProbabilities::Auto, materials, bins), materials),
-            "fog implicit (albedo max 0.8), soot max (albedo max 0.25)");
+            "fog implicit (albedo max 0.8, extinction ratio 1), soot max (albedo max 0.25, extinction ratio 1)");
 }
 
 TEST(EventProbability, OneLaneIsTheSameForEveryScheme) {
@@ -122,6 +135,7 @@ TEST(EventProbability, OneLaneIsTheSameForEveryScheme) {
   for (EventProbabilities e : {EventProbabilities::Auto, EventProbabilities::Average, EventProbabilities::Mixed,
                                EventProbabilities::Implicit}) {
     s.settings.event_probabilities = e;
+    s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
     const auto img = render(s);
     for (std::size_t l = 0; l < ref.lights.size(); ++l) EXPECT_EQ(img.lights[l].data, ref.lights[l].data);
   }
@@ -129,6 +143,7 @@ TEST(EventProbability, OneLaneIsTheSameForEveryScheme) {
 
 TEST(EventProbability, AutoRendersAsTheSchemeItChooses) {
   Scene s = testing::chromatic_scene(8);
+  s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;
   const auto chosen = choose_event_probabilities(EventProbabilities::Auto, s.medium.materials[0], s.settings.bins).scheme;
   const auto a = render(s);
   s.settings.event_probabilities = chosen;
@@ -147,6 +162,7 @@ TEST(EventProbability, BeerLambertPerBinForEveryScheme) {
                                       Spectrum::constant(0.0)),
                         4, 8, 256);
     s.settings.event_probabilities = e;
+    s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
     const auto m = pixel_average(render(s), 0);
     for (int i = 0; i < 6; ++i) {
       const double a = 0.5 + 2.5 * (i / 6.0), b = 0.5 + 2.5 * ((i + 1) / 6.0);
@@ -161,6 +177,7 @@ TEST(EventProbability, ChromaticFurnaceIsOneForEveryScheme) {
   for (EventProbabilities e : kSchemes) {
     Scene s = testing::chromatic_furnace(0.6, 0.3, 8, 64);
     s.settings.event_probabilities = e;
+    s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
     const auto m = pixel_average(render(s), 0);
     for (int i = 0; i < 6; ++i)
       EXPECT_NEAR(m.mean[i], 1.0, kSe * m.se[i] + 1e-6) << event_probabilities_name(e) << " bin " << i;
@@ -175,6 +192,7 @@ testing::BinEstimate single_scattering(const Material& m, double theta0, std::ui
   s.settings.max_bounces = 1;
   s.settings.seed = seed;
   s.settings.event_probabilities = e;
+  s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
   return pixel_average(render(s), 0);
 }
 
@@ -220,6 +238,7 @@ TEST(EventProbability, SaturatedHalfSpaceMatchesChandrasekharForEveryScheme) {
                            testing::directional_light("sun", {std::sin(theta0), 0.0, mu0}), 16, 128);
     s.settings.seed = 13;
     s.settings.event_probabilities = e;
+    s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
     const auto m = pixel_average(render(s), 0);
     for (int b = 0; b < 6; ++b) {
       EXPECT_NEAR(m.mean[b], expected[b], kSe * m.se[b])
@@ -241,6 +260,7 @@ TEST(EventProbability, PinnedValueOfTheImplicitScheme) {
   // sun layers of the determinism tests' chromatic box, 8 spp.
   Scene implicit = testing::chromatic_scene(8);
   implicit.settings.event_probabilities = EventProbabilities::Implicit;
+  implicit.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;
   const auto img = render(implicit);
   const auto env = pixel_average(img, 0), sun = pixel_average(img, 1);
   EXPECT_NEAR(env.mean[0], 0.803799102, 1e-6) << std::setprecision(9) << env.mean[0];
@@ -248,6 +268,7 @@ TEST(EventProbability, PinnedValueOfTheImplicitScheme) {
   // And the closed-form scale it must sit in: within 3 standard errors of the max scheme's render.
   Scene s = testing::chromatic_scene(8);
   s.settings.event_probabilities = EventProbabilities::Max;
+  s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;
   const auto mx = pixel_average(render(s), 0);
   EXPECT_NEAR(env.mean[0], mx.mean[0], 3.0 * std::hypot(env.se[0], mx.se[0]));
 }

@@ -94,8 +94,15 @@ struct PreviewOptions {
 void write_preview(const std::filesystem::path& path, const spectral::SpectralImage& image,
                    const PreviewOptions& opts = {});
 
-// "spectral-tracking" / "single", as stored in prizma:wavelengthSampling and taken by the CLI.
+// "auto" / "spectral-tracking" / "spectral-mis" / "single", as taken by the CLI and the scene file;
+// prizma:wavelengthSampling stores the resolved one (never "auto").
 std::string wavelength_sampling_name(WavelengthSampling w);
 WavelengthSampling parse_wavelength_sampling(std::string_view name, std::string_view input = "wavelength sampling");
+// The estimator a render of `scene` runs: the setting, or for Auto the wavelength-sampling auto rule
+// (docs/renderer.md, "Which scenes take spectral MIS": spectral MIS where some material's
+// MaterialEvents::extinction_ratio exceeds kMisExtinctionRatio and none fluoresces). Throws
+// InputError("wavelength_sampling", …) for spectral-mis with a fluorescent material.
+inline constexpr double kMisExtinctionRatio = 1.1;
+WavelengthSampling resolve_wavelength_sampling(const Scene& scene);
 
 }  // namespace prizma::render
