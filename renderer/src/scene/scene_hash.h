@@ -10,19 +10,9 @@
 
 #include "prizma/render/scene.h"
 #include "prizma/render/volume.h"
+#include "prizma/spectral/fnv1a.h"
 
 namespace prizma::render::scene_file {
-
-// 64-bit FNV-1a.
-class Fnv1a {
- public:
-  void add(const void* data, std::size_t n);
-  void add_spectrum(const spectral::Spectrum& s);
-  std::string hex() const;
-
- private:
-  std::uint64_t m_h = 0xcbf29ce484222325ULL;
-};
 
 // FNV-1a takes one multiply per byte in sequence (1.5 ms for a 64³ volume), so the voxels are hashed
 // in a task beside the rest of the loading (the classification); the value is the same on any
@@ -39,7 +29,7 @@ class SceneHash {
   std::string finish(const Scene& scene);
 
  private:
-  Fnv1a m_h;
+  spectral::Fnv1a m_h;  // over bytes (prizma/spectral/fnv1a.h, the checksum's FNV-1a)
   tbb::task_group m_voxels;
 };
 
