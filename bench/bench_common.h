@@ -14,9 +14,9 @@
 #include <string_view>
 #include <vector>
 
-#include "prizma/relight/light_spec.h"
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
+#include "prizma/spectral/light_spectrum.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
 #include "prizma/render/render.h"
 #include "prizma/render/scene.h"
 #include "prizma/render/transfer_function.h"
@@ -219,13 +219,13 @@ inline double relative_rmse(const spectral::SpectralImage& x, const spectral::Sp
 }
 
 // Relights every layer of `img` with the same light spec (relative to white).
-inline relight::XyzImage relight_all(const spectral::SpectralImage& img, const std::string& light,
+inline spectral::XyzImage relight_all(const spectral::SpectralImage& img, const std::string& light,
                                      Eigen::Vector3d* white = nullptr) {
-  std::vector<relight::LightSpec> specs;
-  for (std::size_t l = 0; l < img.lights.size(); ++l) specs.push_back(relight::parse_light_spec(light));
-  const relight::RelightMatrix m(img.bins, specs, relight::RelightOptions{});
+  std::vector<spectral::LightSpectrum> specs;
+  for (std::size_t l = 0; l < img.lights.size(); ++l) specs.push_back(spectral::parse_light_spectrum(light));
+  const spectral::RelightMatrix m(img.bins, specs, spectral::RelightOptions{});
   if (white) *white = m.mix_white_xyz();
-  return relight::relight_image(img, m);
+  return spectral::relight_image(img, m);
 }
 
 struct DeltaEStats {
@@ -235,7 +235,7 @@ struct DeltaEStats {
 };
 
 // CIEDE2000 between two XYZ images, per pixel, in CIELAB relative to `white`.
-inline DeltaEStats delta_e_stats(const relight::XyzImage& a, const relight::XyzImage& b,
+inline DeltaEStats delta_e_stats(const spectral::XyzImage& a, const spectral::XyzImage& b,
                                  const Eigen::Vector3d& white) {
   std::vector<double> de(a.pixel_count());
   for (std::size_t p = 0; p < a.pixel_count(); ++p) {
@@ -256,15 +256,15 @@ inline DeltaEStats delta_e_stats(const relight::XyzImage& a, const relight::XyzI
 
 // Folded-light images store bin averages of T·E: XYZ = k Σ_i T̄E_i ∫_{bin i} cmf dλ with
 // k = 1/∫_{bins} E ȳ dλ (the same white normalisation as the relighter).
-inline relight::XyzImage folded_to_xyz(const spectral::SpectralImage& img, const std::string& light) {
-  const relight::LightSpec ls = relight::parse_light_spec(light);
+inline spectral::XyzImage folded_to_xyz(const spectral::SpectralImage& img, const std::string& light) {
+  const spectral::LightSpectrum ls = spectral::parse_light_spectrum(light);
   const auto& cmf = spectral::ColorMatching::get(spectral::Observer::Cie1931_2deg);
   const int nb = img.bins.size();
   Eigen::Matrix<double, 3, Eigen::Dynamic> w(3, nb);
   for (int i = 0; i < nb; ++i)
     for (int c = 0; c < 3; ++c) w(c, i) = cmf.channel(c).integrate(img.bins.lo_nm(i), img.bins.hi_nm(i));
   const double k = 1.0 / ls.spectrum.integrate_product(cmf.y(), img.bins.min_nm(), img.bins.max_nm());
-  relight::XyzImage out;
+  spectral::XyzImage out;
   out.width = img.width;
   out.height = img.height;
   out.xyz.assign(3 * img.pixel_count(), 0.0f);

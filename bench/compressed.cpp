@@ -30,8 +30,8 @@
 #include "bench_image.h"
 #include "bench_levels.h"
 #include "prizma/relight/compressed_relight.h"
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_simd.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/relight/kernel_levels.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/spectral_exr.h"
 
@@ -75,7 +75,7 @@ void BM_ExactVsCompressed4K(benchmark::State& state) {
   const spectral::SpectralImage& img = bench_image();
   const relight::CompressedTransport& comp = bench_transport();
   const std::vector<relight::LightSpec> lights = {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")};
-  const relight::RelightMatrix matrix(img.bins, lights, {});
+  const spectral::RelightMatrix matrix(img.bins, lights, {});
   const spectral::DisplayTransform display(spectral::DisplayOptions{});
   const relight::DisplayEncoder8 encoder(display);
   std::vector<float> xyz_exact(3 * img.pixel_count()), xyz_comp(3 * img.pixel_count());
@@ -86,7 +86,7 @@ void BM_ExactVsCompressed4K(benchmark::State& state) {
   auto secs = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
   for (auto _ : state) {
     const auto t0 = clock::now();
-    relight::relight_into(img, matrix, xyz_exact.data());
+    spectral::relight_into(img, matrix, xyz_exact.data());
     const auto t1 = clock::now();
     encoder.encode(xyz_exact.data(), img.pixel_count(), rgb_exact.data());
     const auto t2 = clock::now();
@@ -204,7 +204,8 @@ void time_kernel_levels(benchmark::State& state, spectral::SimdKernel kernel, Fr
 
 void BM_CompressedFrameLevels(benchmark::State& state) {
   const relight::CompressedTransport& t = level_transport();
-  const relight::RelightMatrix matrix(t.bins, {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")}, {});
+  const spectral::RelightMatrix matrix(t.bins, {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")},
+                                       {});
   const spectral::DisplayTransform display(spectral::DisplayOptions{});
   const relight::DisplayEncoder8 encoder(display);
   std::vector<std::uint8_t> rgb(3 * t.pixel_count());
@@ -214,7 +215,8 @@ void BM_CompressedFrameLevels(benchmark::State& state) {
 
 void BM_HalfToFloatLevels(benchmark::State& state) {
   const relight::CompressedTransport& t = level_transport();
-  const relight::RelightMatrix matrix(t.bins, {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")}, {});
+  const spectral::RelightMatrix matrix(t.bins, {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")},
+                                       {});
   std::vector<float> xyz(3 * t.pixel_count());
   time_kernel_levels(state, spectral::SimdKernel::HalfToFloat, [&] { relight::relight_compressed_into(t, matrix, xyz.data()); });
 }

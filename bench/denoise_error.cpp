@@ -70,7 +70,8 @@ double rel_mse(const std::vector<float>& x, const std::vector<float>& r) {
 }
 
 // CIEDE2000 between two relit images at the 99th percentile of the pixels.
-double delta_e_p99(const prizma::relight::XyzImage& a, const prizma::relight::XyzImage& b, const Eigen::Vector3d& white) {
+double delta_e_p99(const prizma::spectral::XyzImage& a, const prizma::spectral::XyzImage& b,
+                   const Eigen::Vector3d& white) {
   std::vector<double> de(a.pixel_count());
   for (std::size_t p = 0; p < a.pixel_count(); ++p) {
     const Eigen::Vector3d xa(a.xyz[3 * p], a.xyz[3 * p + 1], a.xyz[3 * p + 2]);
@@ -121,7 +122,7 @@ void measure_scene(const std::string& name, const Options& o, std::ostringstream
   const pr::Scene scene = load(name, o);
   std::cerr << name << ": reference " << o.ref_spp << " spp (cached in " << o.cache << ")\n";
   const ps::SpectralImage ref = pb::cached_render(with_samples(scene, o.ref_spp, o.seed + 1000003), o.cache, name + "-ref");
-  std::vector<prizma::relight::XyzImage> ref_xyz;
+  std::vector<prizma::spectral::XyzImage> ref_xyz;
   std::vector<Eigen::Vector3d> white(o.lights.size());
   for (std::size_t k = 0; k < o.lights.size(); ++k) ref_xyz.push_back(pb::relight_all(ref, o.lights[k], &white[k]));
   save(o, name + "-ref", ref);

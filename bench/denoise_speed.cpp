@@ -20,9 +20,9 @@
 #include <string>
 
 #include "prizma/denoise/denoise.h"
-#include "prizma/relight/light_spec.h"
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
+#include "prizma/spectral/light_spectrum.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
 
 namespace pd = prizma::denoise;
 namespace ps = prizma::spectral;
@@ -114,8 +114,9 @@ void BM_LuminanceGuides(benchmark::State& state) {
 void BM_RelightBaseline(benchmark::State& state) {
   const ps::SpectralImage& img = image();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(g_threads));
-  const prizma::relight::RelightMatrix m(img.bins, {prizma::relight::parse_light_spec("D65"), prizma::relight::parse_light_spec("A")}, {});
-  for (auto _ : state) benchmark::DoNotOptimize(prizma::relight::relight_image(img, m).xyz.data());
+  const prizma::spectral::RelightMatrix m(
+      img.bins, {prizma::spectral::parse_light_spectrum("D65"), prizma::spectral::parse_light_spectrum("A")}, {});
+  for (auto _ : state) benchmark::DoNotOptimize(prizma::spectral::relight_image(img, m).xyz.data());
   state.counters["pixels_per_s"] = benchmark::Counter(static_cast<double>(img.pixel_count()), benchmark::Counter::kIsIterationInvariantRate);
 }
 

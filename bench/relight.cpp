@@ -31,9 +31,9 @@
 
 #include "bench_image.h"
 #include "bench_levels.h"
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
-#include "prizma/relight/relight_simd.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
+#include "prizma/spectral/relight_simd.h"
 #include "prizma/spectral/spectral_exr.h"
 
 namespace {
@@ -72,15 +72,15 @@ void BM_RelightVsStreamingSum(benchmark::State& state) {
   const auto limit = bench::limit_threads(state.range(0));
   const double load_start = bench::load_average();
   const spectral::SpectralImage& img = bench_image();
-  std::vector<relight::LightSpec> lights = {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")};
-  const relight::RelightMatrix matrix(img.bins, lights, {});
+  std::vector<spectral::LightSpectrum> lights = {spectral::parse_light_spectrum("D65"), spectral::parse_light_spectrum("F11")};
+  const spectral::RelightMatrix matrix(img.bins, lights, {});
   std::vector<float> xyz(3 * img.pixel_count());
   const double bytes = static_cast<double>(img.lights.size() * img.pixel_count() * kBins * sizeof(float));
-  const spectral::SimdLevel dispatched = relight::detail::relight_simd_level();
-  bench::LevelTimes times(relight::detail::relight_simd_levels());
+  const spectral::SimdLevel dispatched = spectral::detail::relight_simd_level();
+  bench::LevelTimes times(spectral::detail::relight_simd_levels());
   std::vector<double> sum_s;
   bench::time_levels(
-      state, times, spectral::SimdKernel::Relight, dispatched, [&] { relight::relight_into(img, matrix, xyz.data()); },
+      state, times, spectral::SimdKernel::Relight, dispatched, [&] { spectral::relight_into(img, matrix, xyz.data()); },
       [&] {  // the streaming read first in every round, so that all see the same machine load
         const auto t0 = std::chrono::steady_clock::now();
         benchmark::DoNotOptimize(streaming_sum(img));
@@ -142,7 +142,7 @@ const spectral::SpectralImage& fluorescent_bench_image(bool with_reradiation) {
 }
 
 void BM_FluorescentVsPlainRelight(benchmark::State& state) {
-  state.SetLabel(relight::detail::relight_simd_target_name(relight::detail::relight_simd_level()));
+  state.SetLabel(spectral::detail::relight_simd_target_name(spectral::detail::relight_simd_level()));
   std::unique_ptr<tbb::global_control> limit;
   if (state.range(0) > 0) {
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -150,9 +150,9 @@ void BM_FluorescentVsPlainRelight(benchmark::State& state) {
   }
   const spectral::SpectralImage& plain = fluorescent_bench_image(false);
   const spectral::SpectralImage& fl = fluorescent_bench_image(true);
-  std::vector<relight::LightSpec> lights = {relight::parse_light_spec("LED-V1"), relight::parse_light_spec("D65*0.2")};
-  const relight::RelightMatrix matrix(plain.bins, lights, {});
-  const relight::ReradiationWeights k = relight::reradiation_weights(fl, matrix.options().cmf);
+  std::vector<spectral::LightSpectrum> lights = {spectral::parse_light_spectrum("LED-V1"), spectral::parse_light_spectrum("D65*0.2")};
+  const spectral::RelightMatrix matrix(plain.bins, lights, {});
+  const spectral::ReradiationWeights k = spectral::reradiation_weights(fl, matrix.options().cmf);
   std::vector<float> xyz(3 * plain.pixel_count());
   const auto cpu_s = [] {
     timespec t{};
@@ -163,11 +163,11 @@ void BM_FluorescentVsPlainRelight(benchmark::State& state) {
   for (auto _ : state) {
     const double c0 = cpu_s();
     auto t0 = std::chrono::steady_clock::now();
-    relight::relight_into(plain, matrix, xyz.data());
+    spectral::relight_into(plain, matrix, xyz.data());
     benchmark::ClobberMemory();
     const double c1 = cpu_s();
     auto t1 = std::chrono::steady_clock::now();
-    relight::relight_into(fl, matrix, xyz.data(), &k);
+    spectral::relight_into(fl, matrix, xyz.data(), &k);
     benchmark::ClobberMemory();
     const double c2 = cpu_s();
     auto t2 = std::chrono::steady_clock::now();
@@ -195,14 +195,14 @@ BENCHMARK(BM_FluorescentVsPlainRelight)->Arg(0)->Arg(1)->UseManualTime()->Unit(b
 void BM_FluorescentRelightLevels(benchmark::State& state) {
   const auto limit = bench::limit_threads(state.range(0));
   const spectral::SpectralImage& fl = fluorescent_bench_image(true);
-  std::vector<relight::LightSpec> lights = {relight::parse_light_spec("LED-V1"), relight::parse_light_spec("D65*0.2")};
-  const relight::RelightMatrix matrix(fl.bins, lights, {});
-  const relight::ReradiationWeights k = relight::reradiation_weights(fl, matrix.options().cmf);
+  std::vector<spectral::LightSpectrum> lights = {spectral::parse_light_spectrum("LED-V1"), spectral::parse_light_spectrum("D65*0.2")};
+  const spectral::RelightMatrix matrix(fl.bins, lights, {});
+  const spectral::ReradiationWeights k = spectral::reradiation_weights(fl, matrix.options().cmf);
   std::vector<float> xyz(3 * fl.pixel_count());
-  bench::LevelTimes times(relight::detail::relight_simd_levels());
+  bench::LevelTimes times(spectral::detail::relight_simd_levels());
   bench::time_levels(
-      state, times, spectral::SimdKernel::Relight, relight::detail::relight_simd_level(),
-      [&] { relight::relight_into(fl, matrix, xyz.data(), &k); }, [] {});
+      state, times, spectral::SimdKernel::Relight, spectral::detail::relight_simd_level(),
+      [&] { spectral::relight_into(fl, matrix, xyz.data(), &k); }, [] {});
 }
 
 BENCHMARK(BM_FluorescentRelightLevels)->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(25);

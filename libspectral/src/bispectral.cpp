@@ -23,7 +23,6 @@ namespace {
 
 constexpr double kSpeedOfLight_m_per_s = 299792458.0;
 constexpr float kHalfMax = 65504.0f;
-// Offset basis of the bispectral values (the diagonal's cbf29ce484222325 rotated by 16 bits).
 
 double unit_factor(const std::string& prefix) {
   static const std::map<std::string, double> kFactors = {

@@ -8,9 +8,8 @@ namespace prizma::spectral {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-double deg(double rad) { return rad * 180.0 / kPi; }
-double rad(double degrees) { return degrees * kPi / 180.0; }
+double deg(double rad) { return rad * 180.0 / std::numbers::pi; }
+double rad(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
 // CIE 1976 L*a*b* constants (CIE 015:2018 §8.2.1, exact rational forms).
 constexpr double kLabEpsilon = 216.0 / 24389.0;

@@ -100,14 +100,6 @@ std::optional<std::array<std::uint8_t, 4>> cicp_code_points(const PictureColourS
   return std::array<std::uint8_t, 4>{*primaries, *transfer, 0, 1};
 }
 
-PictureColourSpace srgb_picture_colour_space() {
-  PictureColourSpace cs;
-  cs.name = "sRGB";
-  cs.chromaticities = {0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290};  // IEC 61966-2-1 table 1
-  cs.cicp = cicp_code_points(cs);  // the default curve: type 4 with the standard's parameters
-  return cs;
-}
-
 bool image_io_module_loaded() {
   const std::lock_guard<std::mutex> lock(g_mutex);
   return g_module != nullptr;

@@ -32,7 +32,7 @@
 #include <utility>
 #include <vector>
 
-#include "prizma/relight/output_image.h"
+#include "prizma/spectral/output_image.h"
 #include "prizma/relight/relight_session.h"
 #include "prizma/render/render.h"
 #include "prizma/render/resume.h"
@@ -371,9 +371,6 @@ std::unique_ptr<relight::RelightSession> relight_session(const py::object& sourc
                                  "values)), or a dict {name: light or None}");
     session->set_every_light(s.lights, light_from(lights, "lights"));
   }
-  if (!std::isfinite(exposure_ev) || std::abs(exposure_ev) > 64.0) {
-    throw InputError("exposure", "must be a finite number of stops within ±64");
-  }
   s.relight.exposure_ev = exposure_ev;
   s.relight.cmf = spectral::parse_observer(cmf, "cmf");
   s.relight.adapt_to_d65 = adapt;
@@ -381,7 +378,7 @@ std::unique_ptr<relight::RelightSession> relight_session(const py::object& sourc
   s.output.display.config = config;
   if (display) s.output.display.display = *display;
   if (colour_space) s.output.display.colour_space = *colour_space;
-  session->apply(s);
+  session->apply(s, {"exposure", "bit_depth"});
   return session;
 }
 
@@ -396,15 +393,15 @@ py::array_t<float> relight_image(const py::object& source, const py::object& lig
   {
     const WithoutGil released;
     session->relight();
-    const relight::XyzImage& xyz = session->xyz();
+    const spectral::XyzImage& xyz = session->xyz();
     // Exactly what write_output_image writes before quantisation: PNG/TIFF the display, clamped; EXR
     // the linear colour space, or XYZ as is (non-finite values 0 in every case).
     if (colour_space) {
-      const auto opts = relight::transform_options(relight::OutputFormat::Exr, session->settings().output);
+      const auto opts = spectral::transform_options(spectral::OutputFormat::Exr, session->settings().output);
       const spectral::DisplayTransform transform(opts);
-      pixels = relight::to_display(xyz, transform);
+      pixels = spectral::to_display(xyz, transform);
     } else if (display) {
-      pixels = relight::to_display(xyz, session->display());
+      pixels = spectral::to_display(xyz, session->display());
       for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
     } else {
       pixels = xyz.xyz;

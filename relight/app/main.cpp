@@ -18,7 +18,7 @@
 #include "prizma/relight/batch_file.h"
 #include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/interactive_shell.h"
-#include "prizma/relight/output_image.h"
+#include "prizma/spectral/output_image.h"
 #include "prizma/relight/relight_session.h"
 #include "prizma/relight/terminal_image.h"
 #include "prizma/relight/serve.h"
@@ -80,6 +80,9 @@ const char* cmf_table(spectral::Observer obs) {
   return "";
 }
 
+// The settings as the command line names them in errors.
+const relight::RelightSettingNames kCliNames{"--exposure", "--bit-depth"};
+
 // The command line's settings on top of the file's default lights.
 relight::RelightSettings settings_from(const CliOptions& o, const relight::RelightSession& session) {
   relight::RelightSettings s = session.settings();
@@ -105,9 +108,6 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
       s.lights[static_cast<std::size_t>(l)] = relight::parse_light_spec(arg.substr(eq + 1), {"--light " + name, {}});
     }
   }
-  if (!std::isfinite(o.exposure_ev) || std::abs(o.exposure_ev) > 64.0) {
-    throw InputError("--exposure", "must be a finite number of stops within ±64");
-  }
   s.relight.exposure_ev = o.exposure_ev;
   s.relight.cmf = spectral::parse_observer(o.cmf, "--cmf");
   s.relight.adapt_to_d65 = o.adapt;
@@ -116,7 +116,7 @@ relight::RelightSettings settings_from(const CliOptions& o, const relight::Relig
   s.output.display.colour_space = o.colour_space;
   if (!o.ocio.empty()) s.output.display.config = o.ocio;
   s.output.bit_depth = o.bit_depth;
-  return s;
+  return s;  // validated by RelightSession::apply(…, kCliNames)
 }
 
 // session.save(), with what libpng prints on stderr (e.g. "libpng error: No IDATs written into
@@ -140,7 +140,7 @@ void save_one_line(relight::RelightSession& session, const std::string& output, 
 // transform), --colour-space when the only output is a display-encoded PNG, TIFF or JPEG. With --batch, -i or --serve either may be used there.
 void check_options_used(const CliOptions& o) {
   if (o.output.empty() || !o.batch.empty() || o.interactive || o.serve) return;
-  const bool exr = relight::output_format_for(o.output) == relight::OutputFormat::Exr;
+  const bool exr = spectral::output_format_for(o.output) == spectral::OutputFormat::Exr;
   if (exr && o.display_given && !o.show) {
     throw InputError("--display", "an EXR output is linear, not display-encoded (XYZ, or --colour-space NAME): "
                                   "--display applies to .png, .tif and .jpg outputs and --show");
@@ -164,8 +164,8 @@ int run(const CliOptions& o) {
   if (!o.serve && !o.serve_options_given.empty()) throw InputError(o.serve_options_given.front(), "only with --serve");
   if (!o.preview.empty() && !o.interactive) throw InputError("--preview", "only with -i/--interactive");
   // Cheap checks first: nothing is loaded when the output cannot be written.
-  if (!o.output.empty()) relight::check_output_path(o.output, "--output");
-  if (!o.preview.empty()) relight::check_output_path(o.preview, "--preview");
+  if (!o.output.empty()) spectral::check_output_path(o.output, "--output");
+  if (!o.preview.empty()) spectral::check_output_path(o.preview, "--preview");
   check_options_used(o);
   if (!o.ocio.empty()) spectral::require_regular_file(o.ocio, "an OCIO config");
 
@@ -179,9 +179,9 @@ int run(const CliOptions& o) {
     return relight::RelightSession(spectral::read_spectral_exr(o.input, read_options), o.input, o.exact);
   });
   const relight::RelightSettings cli_settings = settings_from(o, session);
-  session.apply(cli_settings);
+  session.apply(cli_settings, kCliNames);
   if (!o.output.empty()) {
-    relight::check_output_options(relight::output_format_for(o.output), session.settings().output);
+    spectral::check_output_options(spectral::output_format_for(o.output), session.settings().output);
   }
   if (o.verbose) {
     const auto& s = session.settings();
@@ -221,7 +221,7 @@ int run(const CliOptions& o) {
   spectral::OutputGroup outputs;
   if (!batch.empty()) {
     relight::run_batch(session, batch, o.verbose ? &std::cerr : nullptr, &outputs);
-    session.apply(cli_settings);
+    session.apply(cli_settings, kCliNames);
   }
   if (!o.output.empty()) {
     const double ms = spectral::allocating("relighting", [&] { return session.relight(); });
@@ -230,8 +230,8 @@ int run(const CliOptions& o) {
   }
   outputs.commit();
   if (o.show && !o.interactive) {
-    const relight::XyzImage& img = session.xyz();
-    const std::vector<float> rgb = relight::to_display(img, session.display());
+    const spectral::XyzImage& img = session.xyz();
+    const std::vector<float> rgb = spectral::to_display(img, session.display());
     if (::isatty(STDOUT_FILENO)) {  // sixel, kitty or half blocks, sized to the window
       relight::draw_terminal_image(std::cout, rgb, img.width, img.height,
                                    relight::detect_image_protocol(STDIN_FILENO, STDOUT_FILENO),

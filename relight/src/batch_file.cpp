@@ -3,12 +3,13 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <fstream>
 #include <iterator>
 #include <set>
 
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
@@ -24,9 +25,10 @@ namespace {
 const std::set<std::string> kSettingKeys = {"lights", "exposure", "cmf",        "adapt",   "absolute",
                                             "display", "view",    "colourSpace", "colorSpace", "bitDepth"};
 
-// Applies the keys of one JSON object (an output or "defaults") onto settings. `where` names it.
+// Applies the keys of one JSON object (an output or "defaults") onto settings. `where` names it;
+// `names` gets the names of the values it sets, for RelightSettings::validate.
 void apply_keys(const json& obj, const std::string& where, const RelightSession& session, const fs::path& base_dir,
-                RelightSettings& s) {
+                RelightSettings& s, RelightSettingNames& names) {
   if (obj.is_object() && obj.contains("colourSpace") && obj.contains("colorSpace")) {
     throw InputError(where + ".colorSpace", "give colourSpace or colorSpace (the same key), not both");
   }
@@ -51,10 +53,8 @@ void apply_keys(const json& obj, const std::string& where, const RelightSession&
           throw InputError(input, "must be a spec string (every light) or an object {\"name\": \"spec\"}");
         }
       } else if (key == "exposure") {
-        s.relight.exposure_ev = value.get<double>();
-        if (!std::isfinite(s.relight.exposure_ev) || std::abs(s.relight.exposure_ev) > 64.0) {
-          throw InputError(input, "must be a finite number of stops within ±64");
-        }
+        s.relight.exposure_ev = value.get<double>();  // its range: RelightSettings::validate below
+        names.exposure = input;
       } else if (key == "cmf") {
         s.relight.cmf = spectral::parse_observer(value.get<std::string>(), input);
       } else if (key == "adapt") {
@@ -68,11 +68,13 @@ void apply_keys(const json& obj, const std::string& where, const RelightSession&
       } else if (key == "colourSpace" || key == "colorSpace") {
         s.output.display.colour_space = value.get<std::string>();
       } else if (key == "bitDepth") {
-        // Exactly the integers 8 and 16: nlohmann would truncate 8.7 and wrap 4294967304 to 8.
-        if (!value.is_number_integer() || (value != 8 && value != 16)) {
+        // A JSON integer that an int holds: nlohmann would truncate 8.7 and wrap 4294967304 to 8. The
+        // value's range is RelightSettings::validate's (below).
+        if (!value.is_number_integer() || value < INT_MIN || value > INT_MAX) {
           throw InputError(input, "must be 8 or 16 (got " + value.dump() + ")");
         }
         s.output.bit_depth = value.get<int>();
+        names.bit_depth = input;
       }
     } catch (const json::exception&) {
       throw InputError(input, "wrong type: " + value.dump());
@@ -104,10 +106,11 @@ std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSess
   }
   const fs::path base_dir = path.parent_path();
   RelightSettings defaults = base;
+  RelightSettingNames default_names;
   if (doc.contains("defaults")) {
     if (!doc["defaults"].is_object()) throw InputError(name + ": defaults", "must be an object");
     if (doc["defaults"].contains("file")) throw InputError(name + ": defaults.file", "not allowed in defaults");
-    apply_keys(doc["defaults"], name + ": defaults", session, base_dir, defaults);
+    apply_keys(doc["defaults"], name + ": defaults", session, base_dir, defaults, default_names);
   }
 
   std::vector<BatchOutput> outputs;
@@ -124,13 +127,15 @@ std::vector<BatchOutput> read_batch_file(const fs::path& path, const RelightSess
     const fs::path file = entry["file"].get<std::string>();
     out.file = file.is_absolute() ? file : base_dir / file;
     out.settings = defaults;
-    apply_keys(entry, where, session, base_dir, out.settings);
+    RelightSettingNames names = default_names;
+    apply_keys(entry, where, session, base_dir, out.settings, names);
     // Validate now so that a bad entry stops the batch before anything is written.
-    check_output_path(out.file, where + ".file");
-    RelightMatrix check(session.image().bins, out.settings.lights, out.settings.relight);
-    const OutputFormat format = output_format_for(out.file, where + ".file");
+    out.settings.validate(names);
+    spectral::check_output_path(out.file, where + ".file");
+    spectral::RelightMatrix check(session.image().bins, out.settings.lights, out.settings.relight);
+    const spectral::OutputFormat format = spectral::output_format_for(out.file, where + ".file");
     try {
-      check_output_options(format, out.settings.output);
+      spectral::check_output_options(format, out.settings.output);
     } catch (const InputError& e) {
       throw InputError(where, e.what());
     }

@@ -12,7 +12,7 @@
 #include <limits>
 
 #include "compressed_simd.h"
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectral_exr.h"
 
@@ -70,12 +70,12 @@ AddRow add_row_for(int k) {
 
 // Per layer of the transport, W_l = A·M_l·B_l as float, row-major (3·k), where A is `display`
 // (XYZ → linear display RGB) or the identity; empty for lights that are off. The shape checks and the
-// "off" rule are relight_into's (light_weights, relight_image.h).
-std::vector<std::vector<float>> folded_weights(const CompressedTransport& transport, const RelightMatrix& matrix,
+// "off" rule are spectral::relight_into's (spectral::light_weights, relight_image.h).
+std::vector<std::vector<float>> folded_weights(const CompressedTransport& transport, const spectral::RelightMatrix& matrix,
                                                const Eigen::Matrix3f* display) {
   const int n = transport.bins.size();
   const int layers = static_cast<int>(transport.lights.size());
-  const std::vector<LightWeights> on = light_weights(matrix, layers, n, "compressed transport");
+  const std::vector<spectral::LightWeights> on = spectral::light_weights(matrix, layers, n, "compressed transport");
   const std::size_t pixels = transport.pixel_count();
   for (const CompressedLayer& layer : transport.lights) {
     if (layer.k < 1 || layer.basis.rows() != n || layer.basis.cols() != layer.k ||
@@ -84,7 +84,7 @@ std::vector<std::vector<float>> folded_weights(const CompressedTransport& transp
     }
   }
   std::vector<std::vector<float>> out(static_cast<std::size_t>(layers));
-  for (const LightWeights& lw : on) {
+  for (const spectral::LightWeights& lw : on) {
     const CompressedLayer& layer = transport.lights[static_cast<std::size_t>(lw.light)];
     Eigen::Matrix<double, 3, Eigen::Dynamic> w = matrix.light(lw.light) * layer.basis.cast<double>();
     if (display != nullptr) w = Eigen::Matrix<double, 3, Eigen::Dynamic>(display->cast<double>() * w);
@@ -168,11 +168,11 @@ CompressedTransport compress_transport(const spectral::SpectralImage& image, con
   return out;
 }
 
-std::vector<std::vector<float>> coefficient_weights(const CompressedTransport& transport, const RelightMatrix& matrix) {
+std::vector<std::vector<float>> coefficient_weights(const CompressedTransport& transport, const spectral::RelightMatrix& matrix) {
   return folded_weights(transport, matrix, nullptr);
 }
 
-void relight_compressed_into(const CompressedTransport& transport, const RelightMatrix& matrix, float* xyz_out) {
+void relight_compressed_into(const CompressedTransport& transport, const spectral::RelightMatrix& matrix, float* xyz_out) {
   // W_l = M_l·B_l once per light setting, float, row-major; "off" lights are skipped.
   const std::vector<std::vector<float>> weights = coefficient_weights(transport, matrix);
   std::vector<CoeffTerm> terms;
@@ -202,8 +202,8 @@ void relight_compressed_into(const CompressedTransport& transport, const Relight
   });
 }
 
-XyzImage relight_compressed(const CompressedTransport& transport, const RelightMatrix& matrix) {
-  XyzImage out;
+spectral::XyzImage relight_compressed(const CompressedTransport& transport, const spectral::RelightMatrix& matrix) {
+  spectral::XyzImage out;
   out.width = transport.width;
   out.height = transport.height;
   out.xyz.resize(3 * transport.pixel_count());
@@ -506,7 +506,7 @@ CompressedTransport compress_spectral_exr(const std::filesystem::path& input, co
   return transport;
 }
 
-void relight_compressed_to_display8(const CompressedTransport& transport, const RelightMatrix& matrix,
+void relight_compressed_to_display8(const CompressedTransport& transport, const spectral::RelightMatrix& matrix,
                                     const DisplayEncoder8& encoder, std::uint8_t* rgb_out) {
   const std::size_t pixels = transport.pixel_count();
   if (!encoder.baked() || encoder.step_table().empty() || transport.lights.size() > detail::kMaxFusedLayers) {

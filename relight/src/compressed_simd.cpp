@@ -1,16 +1,17 @@
 // The fused compressed-relight row (compressed_simd.h), compiled by Highway for every x86 level and
-// run at the level spectral::choose_simd_level picks (hwy_levels.h), as relight_simd.cpp is. Per
-// block of lanes (one pixel per lane): the half coefficients of each light are de-interleaved
-// (LoadInterleaved2/3/4 of 16-bit lanes for k ≤ 4; layers of larger k are first converted for the
-// whole row and gathered), widened to float (F16C where the target has it: exact either way),
-// multiplied into linear display RGB with the folded 3×k weights, and each channel is encoded by
-// the step table: one gather of a 32-bit entry (the code and where the next step lies), one integer
-// compare; the codes are narrowed to bytes and stored interleaved. Each coefficient is read from
-// memory once and nothing but the 8-bit codes is written. The row's tail goes through the same
-// block on zero-padded copies, so every pixel gets the same arithmetic.
+// run at the level spectral::choose_simd_level picks (prizma/spectral/hwy_levels.h), as
+// libspectral's relight_simd.cpp is. Per block of lanes (one pixel per lane): the half coefficients
+// of each light are de-interleaved (LoadInterleaved2/3/4 of 16-bit lanes for k ≤ 4; layers of
+// larger k are first converted for the whole row and gathered), widened to float (F16C where the
+// target has it: exact either way), multiplied into linear display RGB with the folded 3×k weights,
+// and each channel is encoded by the step table: one gather of a 32-bit entry (the code and where
+// the next step lies), one integer compare; the codes are narrowed to bytes and stored interleaved.
+// Each coefficient is read from memory once and nothing but the 8-bit codes is written. The row's
+// tail goes through the same block on zero-padded copies, so every pixel gets the same arithmetic.
 // Same bytes at every level: a pixel is one lane, its sums run over the layers and coefficients in
 // the same order at every width, each a product rounded then a sum rounded (no FMA: this file is
-// compiled with -ffp-contract=off); the encoding is integer (tests/relight/compressed_relight_test.cpp).
+// compiled with -ffp-contract=off); the encoding is integer
+// (tests/relight/compressed_relight_test.cpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "compressed_simd.cpp"
 #define HWY_DISABLED_TARGETS HWY_SSSE3  // SSE4 is the 128-bit level (simd_choice.h)
@@ -170,25 +171,29 @@ void CompressedRowToDisplay8(const SimdCoeffLayer* layers, int layer_count, std:
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "hwy_levels.h"
+#include "prizma/spectral/hwy_levels.h"
 
 namespace prizma::relight::detail {
 
 HWY_EXPORT(CompressedRowToDisplay8);
 HWY_EXPORT(HalfToFloat);
 
-std::vector<spectral::SimdLevel> compressed_frame_levels() { return hwy_levels(HWY_DISPATCH_TABLE(CompressedRowToDisplay8)); }
-std::vector<spectral::SimdLevel> half_to_float_levels() { return hwy_levels(HWY_DISPATCH_TABLE(HalfToFloat)); }
+std::vector<spectral::SimdLevel> compressed_frame_levels() {
+  return spectral::detail::hwy_levels(HWY_DISPATCH_TABLE(CompressedRowToDisplay8));
+}
+std::vector<spectral::SimdLevel> half_to_float_levels() {
+  return spectral::detail::hwy_levels(HWY_DISPATCH_TABLE(HalfToFloat));
+}
 
 CompressedRowKernel compressed_row_kernel(spectral::SimdLevel level) {
-  return hwy_function(HWY_DISPATCH_TABLE(CompressedRowToDisplay8), level);
+  return spectral::detail::hwy_function(HWY_DISPATCH_TABLE(CompressedRowToDisplay8), level);
 }
 CompressedRowKernel compressed_row_kernel() {
   return compressed_row_kernel(spectral::choose_simd_level(spectral::SimdKernel::CompressedFrame, compressed_frame_levels()));
 }
 
 HalfToFloatKernel half_to_float_kernel(spectral::SimdLevel level) {
-  return hwy_function(HWY_DISPATCH_TABLE(HalfToFloat), level);
+  return spectral::detail::hwy_function(HWY_DISPATCH_TABLE(HalfToFloat), level);
 }
 HalfToFloatKernel half_to_float_kernel() {
   return half_to_float_kernel(spectral::choose_simd_level(spectral::SimdKernel::HalfToFloat, half_to_float_levels()));

@@ -5,8 +5,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/spectral/colour.h"
+#include "prizma/spectral/default_lights.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/tool_main.h"
 
@@ -15,42 +16,6 @@ namespace prizma::relight {
 namespace {
 
 using spectral::InputError;
-
-struct DefaultLights {
-  std::vector<LightSpec> lights;
-  // Per layer: why the recorded spectrum cannot be used (empty when it can).
-  std::vector<std::string> errors;
-};
-
-// Default light per layer (spectral::default_spectrum). A recorded spectrum that does not parse here
-// (e.g. "csv:lamp.csv" rendered on another machine) does not stop the file from opening: that layer
-// gets an "off" placeholder carrying the recorded text, and relighting fails only if the user leaves
-// it in place. (The reader has checked that the records describe the layers.)
-DefaultLights read_default_lights(const spectral::SpectralImage& image, const std::vector<std::string>& names,
-                                  const std::string& source) {
-  DefaultLights out;
-  for (std::size_t l = 0; l < names.size(); ++l) {
-    const std::string spec = spectral::default_spectrum(image.info.light_records, image.lights[l].name, names.size());
-    const std::string context = source + ": prizma:lights " + names[l];
-    try {
-      out.lights.push_back(parse_light_spec(spec, {context, {}}));
-      out.errors.emplace_back();
-    } catch (const InputError& e) {
-      LightSpec placeholder;
-      placeholder.text = spec;
-      placeholder.off = true;
-      try {  // the recorded factors, which a spectrum given for every light keeps (set_every_light)
-        placeholder.scale = spectral::light_spec_scale(spec, {context, {}});
-      } catch (const InputError&) {
-        placeholder.scale = 1.0;
-      }
-      out.lights.push_back(std::move(placeholder));
-      // Keep the inner input when it is not the context (the CSV's path, say).
-      out.errors.push_back(e.input() == context ? e.reason() : e.what());
-    }
-  }
-  return out;
-}
 
 Eigen::Vector3d xyz_to_srgb_encoded(const Eigen::Vector3d& xyz) {
   const Eigen::Vector3d lin = spectral::xyz_to_linear_srgb(xyz);
@@ -82,36 +47,37 @@ RelightSession::RelightSession(spectral::SpectralImage image, std::string source
   std::vector<std::string> layer_names;
   for (const auto& layer : m_image.lights) layer_names.push_back(layer.name);
   spectral::check_light_records(m_image.info.light_records, layer_names, m_source);  // images made in memory
-  for (const auto& name : layer_names) m_light_names.push_back(name.empty() ? "T" : name);
-  DefaultLights defaults = read_default_lights(m_image, m_light_names, m_source);
-  m_default_lights = std::move(defaults.lights);
-  m_default_errors = std::move(defaults.errors);
+  m_defaults = spectral::default_lights(m_image, m_source);
   RelightSettings settings;
-  settings.lights = m_default_lights;
+  settings.lights = m_defaults.lights;
   apply(std::move(settings));
 }
 
 RelightSession::~RelightSession() = default;
 
 int RelightSession::light_index(std::string_view name, const std::string& input) const {
-  for (std::size_t l = 0; l < m_light_names.size(); ++l)
-    if (m_light_names[l] == name) return static_cast<int>(l);
+  for (std::size_t l = 0; l < light_names().size(); ++l)
+    if (light_names()[l] == name) return static_cast<int>(l);
   std::string known;
-  for (const auto& n : m_light_names) known += (known.empty() ? "" : ", ") + n;
+  for (const auto& n : light_names()) known += (known.empty() ? "" : ", ") + n;
   throw InputError(input, "no light \"" + std::string(name) + "\" in " + m_source + " (its lights: " + known + ")");
 }
 
-void RelightSession::apply(RelightSettings settings) {
+void RelightSettings::validate(const RelightSettingNames& names) const {
+  relight.validate(names.exposure);
+  output.validate(names.bit_depth);
+}
+
+void RelightSession::apply(RelightSettings settings, const RelightSettingNames& names) {
   if (settings.lights.size() != m_image.lights.size()) {
     throw InputError("lights", "expected " + std::to_string(m_image.lights.size()) + " lights, got " +
                                    std::to_string(settings.lights.size()));
   }
+  settings.validate(names);
   // Build everything first; commit only when all of it succeeded.
-  RelightMatrix matrix(m_image.bins, settings.lights, settings.relight);
-  if (settings.output.bit_depth != 8 && settings.output.bit_depth != 16) {
-    throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(settings.output.bit_depth));
-  }
-  if (!settings.output.display.colour_space.empty()) check_output_options(OutputFormat::Exr, settings.output);
+  spectral::RelightMatrix matrix(m_image.bins, settings.lights, settings.relight);
+  if (!settings.output.display.colour_space.empty())
+    spectral::check_output_options(spectral::OutputFormat::Exr, settings.output);
 
   // The display transform is built when first needed (EXR XYZ output needs no OCIO config).
   spectral::DisplayOptions display_options = settings.output.display;
@@ -127,13 +93,13 @@ void RelightSession::apply(RelightSettings settings) {
 }
 
 void RelightSession::set_every_light(std::vector<LightSpec>& lights, const LightSpec& given) const {
-  if (lights.size() != m_light_names.size()) {
-    throw InputError("lights", "expected " + std::to_string(m_light_names.size()) + " lights, got " +
+  if (lights.size() != light_names().size()) {
+    throw InputError("lights", "expected " + std::to_string(light_names().size()) + " lights, got " +
                                    std::to_string(lights.size()));
   }
   for (std::size_t l = 0; l < lights.size(); ++l) {
     const LightSpec& now = lights[l];
-    const bool placeholder = !m_default_errors[l].empty() && now.off && now.text == m_default_lights[l].text;
+    const bool placeholder = m_defaults.placeholder_in_place(l, now);
     lights[l] = spectral::at_light_scale(given, placeholder || !now.off ? now.scale : 0.0);
   }
 }
@@ -151,9 +117,6 @@ void RelightSession::set_light(std::string_view name, std::string_view spec) {
 }
 
 void RelightSession::set_exposure(double exposure_ev) {
-  if (!std::isfinite(exposure_ev) || std::abs(exposure_ev) > 64.0) {
-    throw InputError("exposure", "must be a finite number of stops within ±64");
-  }
   RelightSettings s = m_settings;
   s.relight.exposure_ev = exposure_ev;
   apply(std::move(s));
@@ -176,12 +139,10 @@ void RelightSession::set_display(const std::string& display) {
 }
 
 void RelightSession::check_lights_usable() const {
-  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
-    const LightSpec& light = m_settings.lights[l];
-    if (m_default_errors[l].empty() || !light.off || light.text != m_default_lights[l].text) continue;
-    throw InputError(m_source + ": prizma:lights " + m_light_names[l],
-                     "the recorded spectrum \"" + light.text + "\" cannot be used here (" + m_default_errors[l] +
-                         "); give this light a spectrum (--light " + m_light_names[l] + "=SPEC)");
+  // A layer whose recorded spectrum cannot be used is refused while its placeholder is in place.
+  for (std::size_t l = 0; l < m_defaults.names.size(); ++l) {
+    if (!m_defaults.placeholder_in_place(l, m_settings.lights[l])) continue;
+    m_defaults.require_usable(l, m_source, "; give this light a spectrum (--light " + m_defaults.names[l] + "=SPEC)");
   }
 }
 
@@ -193,17 +154,17 @@ double RelightSession::relight() {
   m_xyz.height = m_image.height;
   m_xyz.xyz.resize(3 * m_image.pixel_count());
   if (!m_image.reradiation.empty() && (m_reradiation.per_light.empty() || m_reradiation.cmf != m_matrix.options().cmf))
-    m_reradiation = reradiation_weights(m_image, m_matrix.options().cmf);  // once per observer
+    m_reradiation = spectral::reradiation_weights(m_image, m_matrix.options().cmf);  // once per observer
   if (m_compressed) {
     relight_compressed_into(*m_compressed, m_matrix, m_xyz.xyz.data());
   } else {
-    relight_into(m_image, m_matrix, m_xyz.xyz.data(), m_image.reradiation.empty() ? nullptr : &m_reradiation);
+    spectral::relight_into(m_image, m_matrix, m_xyz.xyz.data(), m_image.reradiation.empty() ? nullptr : &m_reradiation);
   }
   m_dirty = false;
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-const XyzImage& RelightSession::xyz() {
+const spectral::XyzImage& RelightSession::xyz() {
   relight();
   return m_xyz;
 }
@@ -257,7 +218,7 @@ CompareResult RelightSession::compare(int x1, int y1, int x2, int y2, int radius
     throw InputError("compare", "radius must be between 0 and " + std::to_string(max_radius) + ", not " +
                                     std::to_string(radius));
   }
-  const XyzImage& img = xyz();
+  const spectral::XyzImage& img = xyz();
   // Mean XYZ over the (2r+1)² square around (cx, cy), clipped to the image (never empty: the centre
   // is inside).
   auto mean = [&](int cx, int cy) {
@@ -278,38 +239,21 @@ CompareResult RelightSession::compare(int x1, int y1, int x2, int y2, int radius
 }
 
 void RelightSession::save(const std::filesystem::path& path, const std::string& input, spectral::OutputGroup* group) {
-  write_output_image(path, xyz(), m_settings.output, metadata(), input, group);
+  spectral::write_output_image(path, xyz(), m_settings.output, metadata(), input, group);
 }
 
-ImageMetadata RelightSession::metadata() const {
-  std::vector<spectral::LightRecord> lights;
-  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
-    lights.push_back(spectral::light_record(m_light_names[l], m_settings.lights[l].text));
-  }
-  std::ostringstream exposure;
-  exposure << m_settings.relight.exposure_ev;
-  ImageMetadata md = {
-      {"Software", "prizma-relight " + spectral::prizma_version()},
-      {"prizma:source", m_source},
-      {"prizma:lights", spectral::light_records_json(lights)},
-      {"prizma:exposureEV", exposure.str()},
-      {"prizma:cmf", spectral::observer_name(m_settings.relight.cmf)},
-      {"prizma:units", m_settings.relight.units == spectral::LightUnits::Absolute ? "absolute" : "relative-to-white"},
-      {"prizma:adaptation", m_settings.relight.adapt_to_d65 ? "bradford-to-D65" : "none"},
-      {"prizma:binEdgesNm", m_image.bins.to_string()},
-  };
-  if (!m_settings.output.display.colour_space.empty()) {
-    md.emplace_back("prizma:colourSpace", m_settings.output.display.colour_space);
-  }
-  md.emplace_back("prizma:display", m_settings.output.display.display);
+spectral::ImageMetadata RelightSession::metadata() const {
+  spectral::ImageMetadata md =
+      spectral::relight_metadata("prizma-relight " + spectral::prizma_version(), m_source, light_names(),
+                                 m_settings.lights, m_settings.relight, m_settings.output, m_image.bins);
   if (m_compressed) md.emplace_back("prizma:relitFrom", "spectral-basis coefficients");
   return md;
 }
 
 std::string RelightSession::describe_lights() const {
   std::string out;
-  for (std::size_t l = 0; l < m_light_names.size(); ++l) {
-    out += m_light_names[l] + ": " + m_settings.lights[l].text + " (default " + m_default_lights[l].text + ")\n";
+  for (std::size_t l = 0; l < light_names().size(); ++l) {
+    out += light_names()[l] + ": " + m_settings.lights[l].text + " (default " + m_defaults.lights[l].text + ")\n";
   }
   return out;
 }

@@ -23,6 +23,7 @@
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/output_group.h"
+#include "prizma/spectral/output_image.h"
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/tool_main.h"
 
@@ -87,11 +88,11 @@ struct Options {
 
 // Refuses before any work outputs that cannot be written (spectral::check_output_file: a folder, a
 // device, a FIFO, a missing or read-only folder, a file the run reads, …), a preview in a format that
-// cannot be written, and a preview that is the same file as the output.
+// prizma-relight does not write, and a preview that is the same file as the output.
 void check_outputs(const std::filesystem::path& output, const std::string& output_input, const std::string& preview) {
   std::vector<std::pair<std::filesystem::path, std::string>> outputs{{output, output_input}};
   if (!preview.empty()) {
-    render::check_preview_path(preview, "--preview");
+    spectral::check_output_path(preview, "--preview");
     outputs.emplace_back(preview, "--preview");
   }
   spectral::check_distinct_outputs(outputs);
@@ -135,8 +136,7 @@ class ProgressBar {
 
 // The EXR and the preview appear together or not at all (a full disk on the preview leaves neither).
 void write_outputs(const spectral::SpectralImage& image, const std::filesystem::path& output, bool half,
-                   const std::string& preview, const std::vector<render::Light>& lights,
-                   const std::filesystem::path& spectrum_base_dir, int threads) {
+                   const std::string& preview, int threads) {
   spectral::OutputGroup outputs;
   spectral::ExrWriteOptions wo;
   wo.pixel_type = half ? spectral::ExrPixelType::Half : spectral::ExrPixelType::Float;
@@ -145,9 +145,10 @@ void write_outputs(const spectral::SpectralImage& image, const std::filesystem::
   spectral::write_spectral_exr(output, image, wo);
   if (!preview.empty()) {
     render::PreviewOptions po;
-    po.spectrum_base_dir = spectrum_base_dir;
+    po.source = output.string();
+    po.half = half;
     po.group = &outputs;
-    render::write_preview(preview, image, lights, po);
+    render::write_preview(preview, image, po);
   }
   outputs.commit();
 }
@@ -164,7 +165,8 @@ int merge_main(int argc, char** argv) {
       ->required()
       ->check(spectral::non_empty_path());
   app.add_option("-o,--output", output, "merged output file")->required()->check(spectral::non_empty_path());
-  app.add_option("--preview", preview, "also write an sRGB preview (PNG) under the lights' default spectra")
+  app.add_option("--preview", preview,
+                 "also write the default relight, as prizma-relight OUT -o PREVIEW does (.png, .tif, .jpg, .exr)")
       ->check(spectral::non_empty_path());
   app.add_flag("--half", half, "write half floats");
   app.add_flag("--strict", strict, "refuse shards that leave a gap in the sample range (exit 2)");
@@ -202,7 +204,7 @@ int merge_main(int argc, char** argv) {
       if (strict) throw InputError("merge", what);
       std::cerr << kProgram << ": warning: " << what << "\n";
     }
-    write_outputs(merged, output, half, preview, render::lights_from_image(merged), {}, threads);
+    write_outputs(merged, output, half, preview, threads);
     if (!quiet)
       std::cerr << kProgram << ": merged " << shards.size() << (shards.size() == 1 ? " shard" : " shards")
                 << ", samples " << merged.info.sample_range << " → " << output << "\n";
@@ -263,7 +265,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-majorant-grid", o.no_majorant_grid, "one global majorant instead of the macrocell grid");
   app.add_flag("--variance", o.variance, "also write variance-of-the-mean layers");
   app.add_flag("--half", o.half, "write half floats (refused where values exceed half's range)");
-  app.add_option("--preview", o.preview, "also write an sRGB preview (PNG) under the lights' default spectra")
+  app.add_option("--preview", o.preview,
+                 "also write the default relight, as prizma-relight OUT -o PREVIEW does (.png, .tif, .jpg, .exr)")
       ->check(spectral::non_empty_path());
   app.add_option("--resume", o.resume,
                  "continue a partial (interrupted) render from the scene and options it records, up to "
@@ -280,14 +283,15 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", o.quiet, "no progress bar or summary");
   app.add_flag("-v,--verbose", o.verbose, "print the scene, mode and statistics");
   std::string ocio;  // accepted only to be refused with the reason (the tools share their vocabulary)
-  app.add_option("--ocio", ocio, "refused: a render converts nothing through OpenColorIO (give --ocio to prizma-relight)")
+  app.add_option("--ocio", ocio, "refused: a render relights with the default config only (give --ocio to prizma-relight)")
       ->check(spectral::non_empty_path());
   if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   return spectral::run_tool(kProgram, [&] {
     if (!ocio.empty()) {
-      throw InputError("--ocio", "prizma-render converts nothing through OpenColorIO (the spectral EXR is not "
-                                 "display-encoded; --preview is sRGB by IEC 61966-2-1): give --ocio CONFIG to prizma-relight");
+      throw InputError("--ocio", "prizma-render takes no OpenColorIO config (the spectral EXR is not display-encoded; "
+                                 "--preview is the default relight, in the default config's sRGB display): give --ocio "
+                                 "CONFIG to prizma-relight");
     }
     if (o.spp_text) o.spp = render::scene_integer_override(*o.spp_text, "samples", "--spp");
     if (o.width_text) o.width = static_cast<int>(render::scene_integer_override(*o.width_text, "camera.width", "--width"));
@@ -334,8 +338,7 @@ int main(int argc, char** argv) {
       if (plan.complete) {
         check_outputs(o.output, "-o", o.preview);
         plan.previous.info.render_options = render::overrides_to_json(plan.overrides);
-        write_outputs(plan.previous, o.output, plan.overrides.half, o.preview, plan.scene.lights,
-                      plan.scene.source.parent_path(), o.threads);
+        write_outputs(plan.previous, o.output, plan.overrides.half, o.preview, o.threads);
         return spectral::kExitOk;
       }
       scene = std::move(plan.scene);
@@ -410,8 +413,7 @@ int main(int argc, char** argv) {
       image.info.render_options = render::overrides_to_json(recorded);  // the target, not the union
     }
 
-    write_outputs(image, output, half, o.preview, scene.lights,
-                  scene.source.empty() ? std::filesystem::path() : scene.source.parent_path(), o.threads);
+    write_outputs(image, output, half, o.preview, o.threads);
 
     if (stats.nan_or_inf_count > 0)
       std::cerr << kProgram << ": warning: " << stats.nan_or_inf_count

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "prizma/spectral/error.h"
@@ -26,7 +27,7 @@ CameraModel::CameraModel(const Camera& camera)
   if (m_type == CameraType::Perspective) {
     if (!(camera.fov_y_deg > 0.0 && camera.fov_y_deg < 180.0))
       throw InputError("camera", "fov_y_deg must be in (0, 180), got " + std::to_string(camera.fov_y_deg));
-    m_half_h = std::tan(0.5 * camera.fov_y_deg * 3.14159265358979323846 / 180.0);
+    m_half_h = std::tan(0.5 * camera.fov_y_deg * std::numbers::pi / 180.0);
   } else {
     if (!(camera.ortho_height > 0.0 && std::isfinite(camera.ortho_height)))
       throw InputError("camera", "ortho_height must be > 0, got " + std::to_string(camera.ortho_height));

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -21,7 +22,6 @@ using spectral::InputError;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Environment images: at most 2^25 pixels (8192 × 4096), and at most this many decoded bytes per
 // byte of file, so that a tiny file claiming a huge image is refused before anything is allocated.
 constexpr long long kMaxEnvironmentPixels = 1LL << 25;
@@ -50,7 +50,7 @@ Eigen::Vector3d equal_area_square_to_sphere(double px, double py) {
   const double up = std::abs(u), vp = std::abs(v);
   const double signed_distance = 1.0 - (up + vp);  // from the diagonal: > 0 in the upper hemisphere
   const double r = 1.0 - std::abs(signed_distance);
-  const double phi = (r == 0.0 ? 1.0 : (vp - up) / r + 1.0) * kPi / 4.0;
+  const double phi = (r == 0.0 ? 1.0 : (vp - up) / r + 1.0) * std::numbers::pi / 4.0;
   const double z = std::copysign(1.0 - r * r, signed_distance);
   const double s = r * std::sqrt(std::max(0.0, 2.0 - r * r));
   return {std::copysign(std::cos(phi), u) * s, std::copysign(std::sin(phi), v) * s, z};
@@ -60,7 +60,7 @@ void equal_area_sphere_to_square(const Eigen::Vector3d& d, double& px, double& p
   const double x = std::abs(d.x()), y = std::abs(d.y()), z = std::abs(d.z());
   const double r = std::sqrt(std::max(0.0, 1.0 - z));
   const double a = std::max(x, y), b = a == 0.0 ? 0.0 : std::min(x, y) / a;
-  double phi = std::atan(b) * 2.0 / kPi;
+  double phi = std::atan(b) * 2.0 / std::numbers::pi;
   if (x < y) phi = 1.0 - phi;
   double v = phi * r, u = r - v;
   if (d.z() < 0.0) {
@@ -112,7 +112,7 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> values,
   }
   if (!(peak > 0.0)) throw InputError(input, "every pixel is 0 (the light would send nothing)");
   m_constant = std::all_of(m_values.begin(), m_values.end(), [&](float v) { return v == m_values.front(); });
-  const double r = rotation_deg * kPi / 180.0;
+  const double r = rotation_deg * std::numbers::pi / 180.0;
   m_cos_rot = std::cos(r);
   m_sin_rot = std::sin(r);
 
@@ -171,8 +171,8 @@ void EnvironmentMap::to_uv(const Eigen::Vector3d& d, double& u, double& v) const
     equal_area_sphere_to_square({x, -z, d.y()}, u, v);  // pbrt's light space: its +z is our +y
     return;
   }
-  v = std::acos(std::clamp(d.y(), -1.0, 1.0)) / kPi;
-  u = std::atan2(x, -z) / (2.0 * kPi) + 0.5;
+  v = std::acos(std::clamp(d.y(), -1.0, 1.0)) / std::numbers::pi;
+  u = std::atan2(x, -z) / (2.0 * std::numbers::pi) + 0.5;
   if (m_convention == EnvironmentConvention::Mitsuba) u = u >= 0.5 ? u - 0.5 : u + 0.5;  // Mitsuba's u = 0 is −z
 }
 
@@ -184,8 +184,8 @@ Eigen::Vector3d EnvironmentMap::from_uv(double u, double v) const {
     y = w.z();
     z = -w.y();
   } else {
-    const double theta = kPi * v;
-    const double phi = 2.0 * kPi * (m_convention == EnvironmentConvention::Mitsuba ? u : u - 0.5);
+    const double theta = std::numbers::pi * v;
+    const double phi = 2.0 * std::numbers::pi * (m_convention == EnvironmentConvention::Mitsuba ? u : u - 0.5);
     const double st = std::sin(theta);
     x = st * std::sin(phi);
     y = std::cos(theta);
@@ -196,13 +196,13 @@ Eigen::Vector3d EnvironmentMap::from_uv(double u, double v) const {
 }
 
 double EnvironmentMap::jacobian(double v) const {
-  if (m_convention == EnvironmentConvention::PbrtEqualArea) return 4.0 * kPi;
-  return 2.0 * kPi * kPi * std::sin(kPi * v);
+  if (m_convention == EnvironmentConvention::PbrtEqualArea) return 4.0 * std::numbers::pi;
+  return 2.0 * std::numbers::pi * std::numbers::pi * std::sin(std::numbers::pi * v);
 }
 
 double EnvironmentMap::row_weight(std::size_t y) const {
   if (m_convention == EnvironmentConvention::PbrtEqualArea) return 1.0;
-  return std::sin(kPi * (static_cast<double>(y) + 0.5) / m_height);
+  return std::sin(std::numbers::pi * (static_cast<double>(y) + 0.5) / m_height);
 }
 
 std::size_t EnvironmentMap::pixel_at(double u, double v) const {

@@ -33,20 +33,17 @@ MaterialEvents choose_event_probabilities(EventProbabilities requested, const Ma
                                           const spectral::BinLayout& bins) {
   MaterialEvents c;
   double st_lo = std::numeric_limits<double>::infinity(), st_hi = 0.0;
-  double al_lo = std::numeric_limits<double>::infinity(), al_hi = -std::numeric_limits<double>::infinity();
+  double al_hi = -std::numeric_limits<double>::infinity();
   for (int i = 0; i < bins.size(); ++i) {
     const double lo = bins.lo_nm(i), hi = bins.hi_nm(i), width = bins.width_nm(i);
     const double st = std::max(0.0, m.sigma_t_per_unit.integrate(lo, hi) / width);
-    const double al = std::clamp(m.albedo.integrate(lo, hi) / width, 0.0, 1.0);
     st_lo = std::min(st_lo, st);
     st_hi = std::max(st_hi, st);
-    al_lo = std::min(al_lo, al);
-    al_hi = std::max(al_hi, al);
+    al_hi = std::max(al_hi, std::clamp(m.albedo.integrate(lo, hi) / width, 0.0, 1.0));
   }
   if (st_hi > 0.0) {  // else no extinction anywhere: no collisions to choose for
+    c.albedo_max = al_hi;
     c.extinction_ratio = st_lo > 0.0 ? st_hi / st_lo : std::numeric_limits<double>::infinity();
-    c.albedo_spread = bins.size() > 0 ? al_hi - al_lo : 0.0;
-    c.albedo_max = bins.size() > 0 ? al_hi : 0.0;
   }
   if (requested != EventProbabilities::Auto) {
     c.scheme = requested;
@@ -73,8 +70,7 @@ std::string describe_event_probabilities(const std::vector<MaterialEvents>& choi
   o << std::setprecision(3);
   for (std::size_t k = 0; k < choice.size() && k < materials.size(); ++k)
     o << (k ? ", " : "") << materials[k].name << ' ' << event_probabilities_name(choice[k].scheme)
-      << " (extinction ratio " << choice[k].extinction_ratio << ", albedo " << choice[k].albedo_max - choice[k].albedo_spread
-      << "–" << choice[k].albedo_max << ')';
+      << " (albedo max " << choice[k].albedo_max << ", extinction ratio " << choice[k].extinction_ratio << ')';
   return o.str();
 }
 

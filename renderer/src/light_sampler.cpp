@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <sstream>
 
@@ -12,10 +13,9 @@
 namespace prizma::render {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-double cos_deg(double deg) { return std::cos(deg * kPi / 180.0); }
+double cos_deg(double deg) { return std::cos(deg * std::numbers::pi / 180.0); }
 
 }  // namespace
 

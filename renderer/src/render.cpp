@@ -321,9 +321,7 @@ WavelengthSampling resolve_wavelength_sampling(const Scene& scene) {
                                                 fluorescent->name + "\" fluoresces): use spectral-tracking or auto");
   if (w != WavelengthSampling::Auto) return w;
   if (any_fluorescent) return WavelengthSampling::SpectralTracking;
-  // Spectral MIS where some material's extinction differs across the bins (docs/renderer.md, "Which
-  // scenes take spectral MIS", and the measurements in docs/results.md); with σt the same in every
-  // bin the lanes share their distances and spectral tracking was as good or better.
+  // The rule and the measurements behind it: docs/renderer.md, "Which scenes take spectral MIS".
   for (const MaterialEvents& e :
        choose_event_probabilities(scene.settings.event_probabilities, scene.medium.materials, scene.settings.bins))
     if (e.extinction_ratio > kMisExtinctionRatio) return WavelengthSampling::SpectralMis;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -113,7 +114,7 @@ std::string orient_ras(const nifti_image& nim, Volume& vol) {
   const bool oblique = worst_cos < 0.9999;
   if (oblique) {
     char angle[32];
-    std::snprintf(angle, sizeof angle, "%.1f", std::acos(worst_cos) * 180.0 / 3.14159265358979323846);
+    std::snprintf(angle, sizeof angle, "%.1f", std::acos(worst_cos) * 180.0 / std::numbers::pi);
     vol.warnings.push_back(vol.source + ": NIfTI orientation: the " + source + " is oblique (a file axis is " + angle +
                            "° from the nearest anatomical axis); its axes were snapped to the nearest (file " + file_axes +
                            "), not resampled, so the volume is rotated by up to " + angle + "° from the patient's frame");

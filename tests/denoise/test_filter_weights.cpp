@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -154,7 +155,7 @@ TEST(FilterWeights, TheSureSelectionTakesTheWiderKWhereItIsBetter) {
   // squared error at least 20 % below the narrow k's alone (measured: 31 %), and never above it
   // on either half. With the selection broken (always the narrow k) the first bound fails.
   const double sigma = 0.05;
-  auto truth = [&](int x, int y) { return x < kW / 2 ? 1.0 : 1.0 + 4 * sigma * std::sin(2 * 3.14159265358979 * (x + y) / 6); };
+  auto truth = [&](int x, int y) { return x < kW / 2 ? 1.0 : 1.0 + 4 * sigma * std::sin(2 * std::numbers::pi * (x + y) / 6); };
   const auto g = test::noisy_guides(kW, kH, static_cast<float>(sigma), 5, truth);
   auto half_mse = [&](float wide) {
     DenoiseOptions o;

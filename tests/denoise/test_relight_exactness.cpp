@@ -11,8 +11,8 @@
 
 #include "denoise_test_util.h"
 #include "prizma/denoise/denoise.h"
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
 
 namespace prizma::denoise {
 namespace {
@@ -43,20 +43,20 @@ spectral::SpectralImage noisy_image(int lights, bool with_emission, std::uint32_
 
 // Random light spectra, one per layer: a named illuminant or a gaussian of random centre, width and
 // scale (seeded).
-std::vector<relight::LightSpec> random_lights(int count, std::mt19937& rng) {
+std::vector<spectral::LightSpectrum> random_lights(int count, std::mt19937& rng) {
   const std::vector<std::string> named = {"D65", "A", "F11", "LED-B1", "blackbody:2700K"};
   std::uniform_real_distribution<double> centre(410, 690), width(5, 80), scale(0.2, 2.0);
-  std::vector<relight::LightSpec> out;
+  std::vector<spectral::LightSpectrum> out;
   for (int l = 0; l < count; ++l) {
     const std::string spec = rng() % 2 ? named[rng() % named.size()]
                                        : "gaussian:" + std::to_string(centre(rng)) + ":" + std::to_string(width(rng));
-    out.push_back(relight::parse_light_spec(spec + "*" + std::to_string(scale(rng))));
+    out.push_back(spectral::parse_light_spectrum(spec + "*" + std::to_string(scale(rng))));
   }
   return out;
 }
 
 // XYZ relit in double straight from the per-light matrices (no float path), diagonal terms only.
-std::vector<double> relight_double(const spectral::SpectralImage& img, const relight::RelightMatrix& m) {
+std::vector<double> relight_double(const spectral::SpectralImage& img, const spectral::RelightMatrix& m) {
   const int n = img.bins.size();
   std::vector<double> xyz(3 * img.pixel_count(), 0.0);
   for (std::size_t p = 0; p < img.pixel_count(); ++p)
@@ -72,9 +72,9 @@ void expect_relighting_commutes(const spectral::SpectralImage& img, std::mt19937
   const FilterWeights w = compute_weights(luminance_guides(img));
   const spectral::SpectralImage den = denoise(img, w);
   for (int t = 0; t < trials; ++t) {
-    const relight::RelightMatrix m(img.bins, random_lights(static_cast<int>(img.lights.size()), rng), {});
-    const std::vector<float> a = relight::relight_image(den, m).xyz;
-    const std::vector<float> b = apply(w, relight::relight_image(img, m).xyz, 3);
+    const spectral::RelightMatrix m(img.bins, random_lights(static_cast<int>(img.lights.size()), rng), {});
+    const std::vector<float> a = spectral::relight_image(den, m).xyz;
+    const std::vector<float> b = apply(w, spectral::relight_image(img, m).xyz, 3);
     ASSERT_EQ(a.size(), b.size());
     double worst = 0.0;
     for (std::size_t k = 0; k < a.size(); ++k)

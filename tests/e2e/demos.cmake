@@ -28,13 +28,29 @@ if(TARGET prizma-metamer)
   set_tests_properties(metamer.cli.weights PROPERTIES LABELS e2e
                        ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
 
+  # --scene reads the materials with the renderer's scene reader: by name or by index, the same
+  # albedos as the spec strings the scene gives them (the two designed lights are the same bytes).
+  add_test(NAME metamer.cli.scene_materials
+           COMMAND sh -c "\"$0\" -q light --scene \"$1\" --material-a haze --material-b 1 --reveal -o \"$2/scene.csv\" && \"$0\" -q light --albedo-a 0.9 --albedo-b cc:orange --reveal -o \"$2/specs.csv\" && cmp \"$2/scene.csv\" \"$2/specs.csv\""
+                   $<TARGET_FILE:prizma-metamer> ${PRIZMA_E2E_DIR}/render/tiny.json ${PRIZMA_METAMER_WORK})
+  set_tests_properties(metamer.cli.scene_materials PROPERTIES LABELS e2e
+                       ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+  # A scene prizma-render refuses (a misspelt field) is refused here too, with the renderer's message.
+  file(READ ${PRIZMA_E2E_DIR}/render/tiny.json _metamer_scene)
+  string(REPLACE "\"anisotropy\": 0}" "\"anisotrpy\": 0}" _metamer_scene "${_metamer_scene}")
+  file(WRITE ${PRIZMA_METAMER_WORK}/misspelt.json "${_metamer_scene}")
+  set(PRIZMA_METAMER_TINY ${PRIZMA_E2E_DIR}/render/tiny.json)
+  set(PRIZMA_METAMER_MISSPELT ${PRIZMA_METAMER_WORK}/misspelt.json)
+
   # Input errors: exit 2, one line naming the input, no output file.
   foreach(case
       "bad_albedo|metamer --albedo 1.5 --match-light D65 --split-light A -o OUT|error: albedo: value 1.5"
       "unknown_light|metamer --albedo 0.5 --match-light D66 --split-light A -o OUT|error: --match-light"
       "hide_and_reveal|light --albedo-a cc:7 --albedo-b cc:16 --hide --reveal -o OUT|error: --hide/--reveal"
       "same_albedos|light --albedo-a cc:7 --albedo-b cc:7 --reveal -o OUT|error: albedo-b"
-      "weights_dark_light|--bins linear:700:780:4 weights --light box:400:500 -o OUT|error: light")
+      "weights_dark_light|--bins linear:700:780:4 weights --light box:400:500 -o OUT|error: light"
+      "scene_no_material|light --scene ${PRIZMA_METAMER_TINY} --material-a nope --material-b core --hide -o OUT|no material .nope. (its materials: haze, core)"
+      "scene_misspelt|light --scene ${PRIZMA_METAMER_MISSPELT} --material-a haze --material-b core --hide -o OUT|materials.1..anisotrpy.*unknown field")
     string(REPLACE "|" ";" parts "${case}")
     list(GET parts 0 name)
     list(GET parts 1 args)

@@ -27,6 +27,26 @@ prizma_render_e2e(merge_overlap "merge|shard0.exr|shard0.exr|-o|overlap.exr" EXP
 prizma_render_e2e(resume "${_tiny}|--resume|shard0.exr|--spp|4|-o|resumed.exr|-q" MUST_EXIST resumed.exr
   FIXTURES_REQUIRED render_shards)
 
+# --preview is the render's default relight, the same pixels and records as prizma-relight -o of the
+# file it wrote, a --half file's too (render/preview_is_the_relight.sh).
+find_program(PRIZMA_OIIOTOOL oiiotool)
+if(PRIZMA_OIIOTOOL AND TARGET prizma-relight)
+  foreach(_mode float half)
+    set(_args)
+    if(_mode STREQUAL half)
+      set(_args --half)
+    endif()
+    add_test(NAME render.e2e.preview_is_the_relight_${_mode}
+             COMMAND ${PRIZMA_E2E_DIR}/render/preview_is_the_relight.sh $<TARGET_FILE:prizma-render>
+                     $<TARGET_FILE:prizma-relight> ${PRIZMA_OIIOTOOL} ${PRIZMA_SOURCE_DATA_DIR}/scenes/cube_sphere.json
+                     ${_render_work}/preview_${_mode} ${_args})
+    set_tests_properties(render.e2e.preview_is_the_relight_${_mode} PROPERTIES
+                         ENVIRONMENT "PRIZMA_DATA_DIR=${PRIZMA_SOURCE_DATA_DIR}")
+  endforeach()
+else()
+  prizma_missing_tool_test(render.e2e.preview_is_the_relight "oiiotool (Debian openimageio-tools)")
+endif()
+
 # prizma-render inspect (issue 25 item 9): the scene's volume, histogram and the voxels each material
 # takes (tiny.json: cube_sphere at 16³, haze [50, 150], core [200, 255]); a volume file; a file it
 # cannot inspect is one line, exit 2.

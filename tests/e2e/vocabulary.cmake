@@ -50,7 +50,7 @@ prizma_relight_e2e(ocio_exr_colour_space "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_
 prizma_relight_e2e(err_ocio_xyz_exr "scene.exr|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-o|err15.exr" EXPECT_RC 2
   ERR_REGEX "--ocio: an XYZ EXR output is written as it is" MUST_NOT_EXIST err15.exr)
 prizma_render_e2e(err_ocio "${_tiny}|--ocio|${PRIZMA_SOURCE_DATA_DIR}/ocio/config.ocio|-o|bad.exr" EXPECT_RC 2
-  MUST_NOT_EXIST bad.exr ERR_LINES 1 ERR_REGEX "^prizma-render: error: --ocio: prizma-render converts nothing through OpenColorIO")
+  MUST_NOT_EXIST bad.exr ERR_LINES 1 ERR_REGEX "^prizma-render: error: --ocio: prizma-render takes no OpenColorIO config")
 prizma_relight_e2e(err_ocio_missing "scene.exr|--ocio|nowhere.ocio|-o|err12.png" EXPECT_RC 2
   ERR_REGEX "nowhere\\.ocio" MUST_NOT_EXIST err12.png)
 prizma_relight_e2e(err_display_exr "scene.exr|--display|Display P3|-o|err13.exr" EXPECT_RC 2

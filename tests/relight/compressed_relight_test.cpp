@@ -1,6 +1,6 @@
 // Compressed transport: relighting from k coefficients equals the exact relight of the reconstructed
 // spectra (and of the exact ones at k = n), is independent of the thread count, and the baked 8-bit
-// display encoder writes what write_output_image writes into an 8-bit PNG.
+// display encoder writes what spectral::write_output_image writes into an 8-bit PNG.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <Imath/half.h>
@@ -13,14 +13,14 @@
 #include <random>
 
 #include "prizma/relight/compressed_relight.h"
-#include "prizma/relight/output_image.h"
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/output_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/relight/relight_session.h"
-#include "prizma/relight/relight_simd.h"
+#include "prizma/relight/kernel_levels.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/simd_choice.h"
-#include "relight_test_util.h"
+#include "spectral/relight_test_util.h"
 
 namespace prizma::relight {
 namespace {
@@ -32,7 +32,7 @@ spectral::SpectralImage smooth_image(int width, int height, int bins) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(-0.0005f, 0.0005f);
   const spectral::BinLayout layout = spectral::BinLayout::linear(400.0, 700.0, bins);
-  return test::make_image(width, height, layout, {"key", "back"}, [&](int l, int p, int i) {
+  return spectral::test::make_image(width, height, layout, {"key", "back"}, [&](int l, int p, int i) {
     const double x = static_cast<double>(p % width) / width, y = static_cast<double>(p / width) / height;
     const double lambda = layout.centre_nm(i);
     const double mu = 450.0 + 200.0 * x + 30.0 * l;
@@ -97,8 +97,8 @@ TEST(CompressedRelight, AtKEqualToNOnlyHalfRoundingIsLost) {
   }
   EXPECT_LE(worst, std::ldexp(1.0, -11) + 1e-6);
   EXPECT_GT(worst_float, 1e-6) << "half, not float: some bin moves";
-  const RelightMatrix m(img.bins, two_lights(), {});
-  EXPECT_LT(max_abs_diff(relight_compressed(t, m).xyz, relight_image(back, m).xyz), 2e-5);
+  const spectral::RelightMatrix m(img.bins, two_lights(), {});
+  EXPECT_LT(max_abs_diff(relight_compressed(t, m).xyz, spectral::relight_image(back, m).xyz), 2e-5);
 }
 
 // The coefficients are scaled by a power of two into [2^14, 2^15) per layer, so the transport's
@@ -140,22 +140,22 @@ TEST(CompressedRelight, EqualsExactRelightOfTheReconstructedSpectra) {
     for (const auto& e : c.errors) EXPECT_LE(e.percentile, 0.5) << c.name << " " << e.light;
   }
   const spectral::SpectralImage back = reconstructed(img, t);
-  RelightOptions opts;
+  spectral::RelightOptions opts;
   opts.exposure_ev = 0.5;
   opts.adapt_to_d65 = true;
-  const RelightMatrix m(img.bins, two_lights(), opts);
-  EXPECT_LT(max_abs_diff(relight_compressed(t, m).xyz, relight_image(back, m).xyz), 2e-5);
+  const spectral::RelightMatrix m(img.bins, two_lights(), opts);
+  EXPECT_LT(max_abs_diff(relight_compressed(t, m).xyz, spectral::relight_image(back, m).xyz), 2e-5);
   // A light that is off contributes nothing.
-  const RelightMatrix off(img.bins, {parse_light_spec("off"), parse_light_spec("F11")}, {});
+  const spectral::RelightMatrix off(img.bins, {parse_light_spec("off"), parse_light_spec("F11")}, {});
   spectral::SpectralImage only_back = back;
   for (float& v : only_back.lights[0].data) v = 0.0f;
-  EXPECT_LT(max_abs_diff(relight_compressed(t, off).xyz, relight_image(only_back, off).xyz), 2e-5);
+  EXPECT_LT(max_abs_diff(relight_compressed(t, off).xyz, spectral::relight_image(only_back, off).xyz), 2e-5);
 }
 
 TEST(CompressedRelight, IndependentOfTheThreadCount) {
   const auto img = smooth_image(64, 48, 16);
   const CompressedTransport t = compress_transport(img);
-  const RelightMatrix m(img.bins, two_lights(), {});
+  const spectral::RelightMatrix m(img.bins, two_lights(), {});
   std::vector<float> one, two;
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
@@ -171,28 +171,28 @@ TEST(CompressedRelight, IndependentOfTheThreadCount) {
 TEST(CompressedRelight, RefusesAMatrixOfOtherShape) {
   const auto img = smooth_image(8, 8, 16);
   const CompressedTransport t = compress_transport(img);
-  const RelightMatrix m(img.bins, {parse_light_spec("D65")}, {});
+  const spectral::RelightMatrix m(img.bins, {parse_light_spec("D65")}, {});
   EXPECT_THROW(relight_compressed(t, m), spectral::RuntimeError);
 }
 
 TEST(DisplayEncoder8, BakedSrgbWritesWhatAnEightBitPngHolds) {
   const auto img = smooth_image(96, 64, 16);
-  const RelightMatrix m(img.bins, two_lights(), {});
-  XyzImage xyz = relight_image(img, m);
+  const spectral::RelightMatrix m(img.bins, two_lights(), {});
+  spectral::XyzImage xyz = spectral::relight_image(img, m);
   // Dark, bright, out-of-gamut and non-finite colours too.
   for (std::size_t i = 0; i < 600; ++i) xyz.xyz[i] *= std::pow(10.0f, -3.0f + 0.01f * static_cast<float>(i));
   xyz.xyz[3 * 700] = -0.2f;
   xyz.xyz[3 * 701 + 1] = std::numeric_limits<float>::quiet_NaN();
   xyz.xyz[3 * 702 + 2] = std::numeric_limits<float>::infinity();
-  OutputOptions opts;
+  spectral::OutputOptions opts;
   const spectral::DisplayTransform display(opts.display);
   const DisplayEncoder8 encoder(display);
   EXPECT_TRUE(encoder.baked());
   std::vector<std::uint8_t> fast(xyz.xyz.size());
   encoder.encode(xyz.xyz.data(), xyz.pixel_count(), fast.data());
 
-  const fs::path dir = test::scratch_dir("encoder8");
-  write_output_image(dir / "a.png", xyz, opts, {});
+  const fs::path dir = spectral::test::scratch_dir("encoder8");
+  spectral::write_output_image(dir / "a.png", xyz, opts, {});
   auto in = OIIO::ImageInput::open((dir / "a.png").string());
   ASSERT_TRUE(in);
   std::vector<std::uint8_t> png(fast.size());
@@ -261,14 +261,14 @@ TEST(DisplayEncoder8, StepTableCodeIsExactlyTheThresholdCount) {
 
 TEST(LightWeights, SkipsLightsThatAreOffAndChecksTheShape) {
   const auto bins = spectral::BinLayout::linear(400.0, 700.0, 8);
-  const RelightMatrix m(bins, {parse_light_spec("off"), parse_light_spec("D65")}, {});
-  const std::vector<LightWeights> on = light_weights(m, 2, 8, "image");
+  const spectral::RelightMatrix m(bins, {parse_light_spec("off"), parse_light_spec("D65")}, {});
+  const std::vector<spectral::LightWeights> on = spectral::light_weights(m, 2, 8, "image");
   ASSERT_EQ(on.size(), 1u);
   EXPECT_EQ(on[0].light, 1);
   ASSERT_EQ(on[0].weights.size(), 24u);
   EXPECT_FLOAT_EQ(on[0].weights[8 + 3], static_cast<float>(m.light(1)(1, 3)));  // Y row, bin 3
-  EXPECT_THROW(light_weights(m, 3, 8, "image"), spectral::RuntimeError);
-  EXPECT_THROW(light_weights(m, 2, 9, "image"), spectral::RuntimeError);
+  EXPECT_THROW(spectral::light_weights(m, 3, 8, "image"), spectral::RuntimeError);
+  EXPECT_THROW(spectral::light_weights(m, 2, 9, "image"), spectral::RuntimeError);
 }
 
 // The fused frame (coefficients → 8-bit codes per row, display matrix folded into the weights)
@@ -281,9 +281,9 @@ TEST(DisplayEncoder8, FusedFrameEqualsRelightThenEncode) {
   ASSERT_TRUE(encoder.baked());
   ASSERT_FALSE(encoder.step_table().empty()) << "the sRGB curve gets the step table";
   for (const auto& lights : {two_lights(), std::vector<LightSpec>{parse_light_spec("off"), parse_light_spec("F11*3")}}) {
-    RelightOptions o;
+    spectral::RelightOptions o;
     o.exposure_ev = 0.7;
-    const RelightMatrix m(img.bins, lights, o);
+    const spectral::RelightMatrix m(img.bins, lights, o);
     std::vector<float> xyz(3 * img.pixel_count());
     relight_compressed_into(t, m, xyz.data());
     std::vector<std::uint8_t> ref(xyz.size()), fused(xyz.size()), fused1(xyz.size());
@@ -330,7 +330,7 @@ TEST(DisplayEncoder8, FusedFrameOnEverySimdLevelAndEveryKSameBytes) {
   const spectral::DisplayTransform display(spectral::DisplayOptions{});
   const DisplayEncoder8 encoder(display);
   ASSERT_FALSE(encoder.step_table().empty());
-  const RelightMatrix m(img.bins, {parse_light_spec("D65*0.8"), parse_light_spec("F11")}, {});
+  const spectral::RelightMatrix m(img.bins, {parse_light_spec("D65*0.8"), parse_light_spec("F11")}, {});
   const std::vector<spectral::SimdLevel> levels = detail::kernel_simd_levels(spectral::SimdKernel::CompressedFrame);
   ASSERT_FALSE(levels.empty());
   for (const int k : {1, 2, 3, 4, 5, 16}) {
@@ -387,7 +387,7 @@ TEST(DisplayEncoder8, FusedFrameSameBytesAtEveryLevelOnAMillionCodes) {
   }
   const spectral::DisplayTransform display(spectral::DisplayOptions{});
   const DisplayEncoder8 encoder(display);
-  const RelightMatrix m(t.bins, {parse_light_spec("D65"), parse_light_spec("F11*0.5")}, {});
+  const spectral::RelightMatrix m(t.bins, {parse_light_spec("D65"), parse_light_spec("F11*0.5")}, {});
   std::vector<std::uint8_t> first, codes(3 * t.pixel_count());
   for (const spectral::SimdLevel level : detail::kernel_simd_levels(spectral::SimdKernel::CompressedFrame)) {
     const spectral::ForcedSimdLevel forced(spectral::SimdKernel::CompressedFrame, level);
@@ -405,7 +405,7 @@ TEST(DisplayEncoder8, FusedFrameSameBytesAtEveryLevelOnAMillionCodes) {
 // prizma-relight compress --compact: the file relights (from its coefficients alone) within the
 // stated bound of the exact relight, for each light alone under each test light.
 TEST(CompressFile, CompactFileRelitWithinTheBound) {
-  const fs::path dir = test::scratch_dir("compress");
+  const fs::path dir = spectral::test::scratch_dir("compress");
   const auto img = smooth_image(48, 40, 16);
   spectral::write_spectral_exr(dir / "in.exr", img);
   CompressFileOptions options;
@@ -434,8 +434,8 @@ TEST(CompressFile, CompactFileRelitWithinTheBound) {
         s->set_light(self, light);
         s->set_light(other, "off");
       }
-      const XyzImage& a = exact.xyz();
-      const XyzImage& b = compact.xyz();
+      const spectral::XyzImage& a = exact.xyz();
+      const spectral::XyzImage& b = compact.xyz();
       const Eigen::Vector3d white = exact.matrix().mix_white_xyz();
       std::vector<double> de(a.pixel_count());
       for (std::size_t p = 0; p < de.size(); ++p)
@@ -465,7 +465,7 @@ TEST(CompressFile, CompactFileRelitWithinTheBound) {
 }
 
 TEST(CompressFile, RefusesACompactInputABadBoundAndAFluorescentFile) {
-  const fs::path dir = test::scratch_dir("compress-refuse");
+  const fs::path dir = spectral::test::scratch_dir("compress-refuse");
   spectral::write_spectral_exr(dir / "in.exr", smooth_image(16, 8, 8));
   CompressFileOptions options;
   options.compact = true;

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "prizma/relight/output_image.h"
-#include "relight/relight_test_util.h"
+#include "prizma/spectral/output_image.h"
+#include "spectral/relight_test_util.h"
 
 namespace prizma::relight {
 namespace {
@@ -25,8 +25,8 @@ namespace fs = std::filesystem;
 
 // Three saturated colours and a grey, as XYZ: what a reader that ignores chromaticities must still
 // tell apart (channels X, Y, Z were read as one grey by RGBA readers).
-XyzImage four_colours() {
-  XyzImage img;
+spectral::XyzImage four_colours() {
+  spectral::XyzImage img;
   img.width = 4;
   img.height = 1;
   img.xyz = {0.41f, 0.21f, 0.02f, 0.36f, 0.72f, 0.12f, 0.18f, 0.07f, 0.95f, 0.50f, 0.5f, 0.5f};
@@ -34,9 +34,9 @@ XyzImage four_colours() {
 }
 
 TEST(OutputInterop, XyzExrIsReadByOpenExrsRgbaReaderAsItsColours) {
-  const fs::path dir = test::scratch_dir("output-xyz-rgba");
-  const XyzImage img = four_colours();
-  write_output_image(dir / "xyz.exr", img, OutputOptions{}, {});
+  const fs::path dir = spectral::test::scratch_dir("output-xyz-rgba");
+  const spectral::XyzImage img = four_colours();
+  spectral::write_output_image(dir / "xyz.exr", img, spectral::OutputOptions{}, {});
 
   Imf::RgbaInputFile in((dir / "xyz.exr").c_str());
   EXPECT_EQ(in.channels(), Imf::WRITE_RGB);  // R, G, B present: not a luminance-only (grey) file
@@ -69,9 +69,9 @@ TEST(OutputInterop, XyzExrIsReadByOpenExrsRgbaReaderAsItsColours) {
 }
 
 TEST(OutputInterop, XyzExrIsReadByOpenImageIoAsRgbWithXyzChromaticities) {
-  const fs::path dir = test::scratch_dir("output-xyz-oiio");
-  const XyzImage img = four_colours();
-  write_output_image(dir / "xyz.exr", img, OutputOptions{}, {});
+  const fs::path dir = spectral::test::scratch_dir("output-xyz-oiio");
+  const spectral::XyzImage img = four_colours();
+  spectral::write_output_image(dir / "xyz.exr", img, spectral::OutputOptions{}, {});
   auto in = OIIO::ImageInput::open((dir / "xyz.exr").string());
   ASSERT_TRUE(in) << OIIO::geterror();
   const OIIO::ImageSpec& spec = in->spec();
@@ -129,19 +129,19 @@ TEST(OutputInterop, DisplayPngsCarryTheCicpChunkOfTheirDisplay) {
   // sRGB for sRGB and Display P3, 1 (BT.709 / BT.2020 with the BT.1886 display, a 2.4 power) for the
   // shipped Rec.2020 display, matrix 0 (RGB), full range 1; after IHDR, before IDAT, valid CRC,
   // beside the ICC profile (iCCP), and the file still reads.
-  const fs::path dir = test::scratch_dir("output-cicp");
-  XyzImage img = four_colours();
+  const fs::path dir = spectral::test::scratch_dir("output-cicp");
+  spectral::XyzImage img = four_colours();
   const std::pair<const char*, std::string> cases[] = {
       {"sRGB", std::string("\x01\x0d\x00\x01", 4)},
       {"Display P3", std::string("\x0c\x0d\x00\x01", 4)},
       {"Rec.2020", std::string("\x09\x01\x00\x01", 4)}};
   for (const auto& [display, want] : cases) {
-    OutputOptions opts;
+    spectral::OutputOptions opts;
     opts.display.display = display;
     for (int bits : {8, 16}) {
       opts.bit_depth = bits;
       const fs::path path = dir / (std::string(display) + std::to_string(bits) + ".png");
-      write_output_image(path, img, opts, {});
+      spectral::write_output_image(path, img, opts, {});
       const std::vector<PngChunk> chunks = png_chunks(path);
       ASSERT_GE(chunks.size(), 3u) << path;
       EXPECT_EQ(chunks[0].type, "IHDR");
@@ -168,15 +168,15 @@ TEST(OutputInterop, TiffAndJpegCarryTheProvenanceAndExifColourSpace) {
   // relight.md promises prizma:* provenance in every output: TIFF and JPEG hold it as one JSON
   // object in their image description (OpenImageIO drops prizma:* keys there). A JPEG's Exif
   // ColorSpace says sRGB (1) or "uncalibrated" (0xFFFF: another space, the ICC profile says which).
-  const fs::path dir = test::scratch_dir("output-provenance");
-  const ImageMetadata md = {{"Software", "prizma-relight test"}, {"prizma:source", "cs.exr"},
+  const fs::path dir = spectral::test::scratch_dir("output-provenance");
+  const spectral::ImageMetadata md = {{"Software", "prizma-relight test"}, {"prizma:source", "cs.exr"},
                             {"prizma:lights", R"([{"name":"key","spectrum":"F11*0.2"}])"}, {"prizma:display", "x"}};
   for (const char* ext : {".tif", ".jpg"}) {
     for (const char* display : {"sRGB", "Display P3"}) {
-      OutputOptions opts;
+      spectral::OutputOptions opts;
       opts.display.display = display;
       const fs::path path = dir / (std::string(display) + ext);
-      write_output_image(path, four_colours(), opts, md);
+      spectral::write_output_image(path, four_colours(), opts, md);
       auto in = OIIO::ImageInput::open(path.string());
       ASSERT_TRUE(in) << OIIO::geterror();
       const OIIO::ImageSpec& spec = in->spec();

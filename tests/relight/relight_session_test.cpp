@@ -3,19 +3,22 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cmath>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <regex>
 #include <sstream>
 
 #include "prizma/relight/batch_file.h"
 #include "prizma/relight/interactive_shell.h"
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/relight/relight_session.h"
+#include "prizma/relight/serve_state.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
-#include "relight/relight_test_util.h"
+#include "spectral/relight_test_util.h"
 
 namespace prizma::relight {
 namespace {
@@ -27,7 +30,7 @@ using spectral::BinLayout;
 // red-ish transport; pixel (5, 3) is black under both.
 fs::path write_fixture(const fs::path& dir) {
   const BinLayout bins = BinLayout::linear(400.0, 700.0, 12);
-  auto img = test::make_image(6, 4, bins, {"key", "back"}, [](int l, int p, int i) {
+  auto img = spectral::test::make_image(6, 4, bins, {"key", "back"}, [](int l, int p, int i) {
     const int x = p % 6;
     if (p == 23) return 0.0f;
     if (l == 0) return x < 3 ? 0.5f : 0.0f;
@@ -51,8 +54,43 @@ std::vector<float> read_pixels(const fs::path& path, int& channels, OIIO::ImageS
   return px;
 }
 
+// The exposure and bit-depth limits are RelightSettings::validate's alone (issue 22): every front end
+// refuses the same values with the same words, naming the value as its user gave it. The page's state
+// said "must be within ±64 stops", a session's bit depth "must be 8 or 16, not 12".
+TEST(RelightSettings, EveryFrontEndRefusesWithTheOneCheck) {
+  const fs::path dir = spectral::test::scratch_dir("validate");
+  RelightSession session(write_fixture(dir));
+  auto error = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const spectral::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string range = ": must be a finite number of stops within ±64";
+  EXPECT_EQ(error([&] { session.set_exposure(64.5); }), "exposure" + range);
+  EXPECT_EQ(error([&] { settings_from_state({{"exposure", "65"}}, session, session.settings()); }), "state: exposure" + range);
+  auto batch = [&](const std::string& json) {
+    std::ofstream(dir / "b.json") << json;
+    return error([&] { read_batch_file(dir / "b.json", session, session.settings()); });
+  };
+  const std::string b = (dir / "b.json").string();
+  EXPECT_EQ(batch(R"({"outputs": [{"file": "a.png", "exposure": -70}]})"), b + ": outputs[0].exposure" + range);
+  EXPECT_EQ(batch(R"({"defaults": {"exposure": 1e300}, "outputs": [{"file": "a.png"}]})"), b + ": defaults.exposure" + range);
+  EXPECT_EQ(batch(R"({"outputs": [{"file": "a.png", "bitDepth": 24}]})"), b + ": outputs[0].bitDepth: must be 8 or 16 (got 24)");
+  RelightSettings s = session.settings();
+  s.output.bit_depth = 12;
+  EXPECT_EQ(error([&] { session.apply(s, {"--exposure", "--bit-depth"}); }), "--bit-depth: must be 8 or 16 (got 12)");
+  s.output.bit_depth = 16;
+  s.relight.exposure_ev = -64.0;  // the limit itself is allowed
+  EXPECT_EQ(error([&] { session.apply(s); }), "no error");
+  s.relight.exposure_ev = std::nan("");
+  EXPECT_EQ(error([&] { s.validate({"--exposure", "--bit-depth"}); }), "--exposure" + range);
+}
+
 TEST(RelightSession, LoadsDefaultsFromPrizmaLights) {
-  const fs::path dir = test::scratch_dir("defaults");
+  const fs::path dir = spectral::test::scratch_dir("defaults");
   RelightSession session(write_fixture(dir));
   ASSERT_EQ(session.light_names(), (std::vector<std::string>{"key", "back"}));
   EXPECT_EQ(session.settings().lights[0].text, "D65");
@@ -63,9 +101,9 @@ TEST(RelightSession, LoadsDefaultsFromPrizmaLights) {
 // A file rendered elsewhere may record a light as a CSV that is not here: it still opens, relighting
 // with that default fails naming the light, and giving the light a spectrum makes it work.
 TEST(RelightSession, UnusableRecordedLightFailsOnlyWhenUsed) {
-  const fs::path dir = test::scratch_dir("unusable_default");
+  const fs::path dir = spectral::test::scratch_dir("unusable_default");
   const BinLayout bins = BinLayout::linear(400.0, 700.0, 12);
-  auto img = test::make_image(6, 4, bins, {"key", "back"}, [](int, int, int) { return 0.5f; });
+  auto img = spectral::test::make_image(6, 4, bins, {"key", "back"}, [](int, int, int) { return 0.5f; });
   img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"key","spectrum":"D65"},{"name":"back","spectrum":"csv:/nowhere/lamp.csv*2"}])", "test");
   const fs::path path = dir / "elsewhere.exr";
   spectral::write_spectral_exr(path, img);
@@ -98,7 +136,7 @@ TEST(RelightSession, UnusableRecordedLightFailsOnlyWhenUsed) {
 }
 
 TEST(RelightSession, UnknownLightNameListsTheFilesLights) {
-  const fs::path dir = test::scratch_dir("unknown");
+  const fs::path dir = spectral::test::scratch_dir("unknown");
   RelightSession session(write_fixture(dir));
   try {
     session.set_light("fill", "D65");
@@ -111,7 +149,7 @@ TEST(RelightSession, UnknownLightNameListsTheFilesLights) {
 }
 
 TEST(RelightSession, ProbeReportsBinsXyzLabAndSrgb) {
-  const fs::path dir = test::scratch_dir("probe");
+  const fs::path dir = spectral::test::scratch_dir("probe");
   RelightSession session(write_fixture(dir));
   session.set_light("", "D65");
   const ProbeResult r = session.probe(1, 1);
@@ -130,20 +168,20 @@ TEST(RelightSession, ProbeReportsBinsXyzLabAndSrgb) {
 }
 
 TEST(RelightSession, CompareGivesZeroForEqualRegionsAndPositiveOtherwise) {
-  const fs::path dir = test::scratch_dir("compare");
+  const fs::path dir = spectral::test::scratch_dir("compare");
   RelightSession session(write_fixture(dir));
   EXPECT_NEAR(session.compare(0, 0, 1, 1).delta_e2000, 0.0, 1e-9);
   EXPECT_GT(session.compare(0, 0, 4, 0).delta_e2000, 5.0);
   // Region mean: a radius-1 square around (2, 1) covers columns 1–3 (two grey, one red-ish).
   const CompareResult c = session.compare(2, 1, 2, 1, 1);
-  const XyzImage& img = session.xyz();
+  const spectral::XyzImage& img = session.xyz();
   const Eigen::Vector3d mean = (img.at(1, 0) + img.at(2, 0) + img.at(3, 0) + img.at(1, 1) + img.at(2, 1) +
                                 img.at(3, 1) + img.at(1, 2) + img.at(2, 2) + img.at(3, 2)) / 9.0;
   EXPECT_NEAR((c.xyz1 - mean).norm(), 0.0, 1e-6);
 }
 
 TEST(RelightSession, ExrOutputHoldsTheXyzAndMetadata) {
-  const fs::path dir = test::scratch_dir("exr");
+  const fs::path dir = spectral::test::scratch_dir("exr");
   RelightSession session(write_fixture(dir));
   session.set_exposure(1.0);
   const fs::path out = dir / "out.exr";
@@ -162,7 +200,7 @@ TEST(RelightSession, ExrOutputHoldsTheXyzAndMetadata) {
 // What the shell's save and the live page's Save call: an output that is the file being relit is
 // refused naming the caller's input ("save", "file"), the file left as it was (docs/errors.md).
 TEST(RelightSession, SaveNeverReplacesTheFileItRelights) {
-  const fs::path dir = test::scratch_dir("save_input");
+  const fs::path dir = spectral::test::scratch_dir("save_input");
   const spectral::InputRecording recording;  // as run_tool holds it in the tools
   const fs::path in = write_fixture(dir);
   RelightSession session(in);
@@ -182,7 +220,7 @@ TEST(RelightSession, SaveNeverReplacesTheFileItRelights) {
 }
 
 TEST(InteractiveShell, ScriptedSessionThroughAStream) {
-  const fs::path dir = test::scratch_dir("shell");
+  const fs::path dir = spectral::test::scratch_dir("shell");
   RelightSession session(write_fixture(dir));
   const fs::path saved = dir / "saved.exr";
   const fs::path preview = dir / "preview.exr";
@@ -214,7 +252,7 @@ TEST(InteractiveShell, ScriptedSessionThroughAStream) {
   EXPECT_GT(ys[0], 0.1);
   EXPECT_NEAR(ys[1], 2.0 * ys[0], 1e-5);
   // Under E with key off, pixel (4, 2) holds back's ramp: Y = Σ_i (i/11)·W_y,i (W normalised).
-  const RelightMatrix e(session.image().bins, {parse_light_spec("off"), parse_light_spec("E")}, {});
+  const spectral::RelightMatrix e(session.image().bins, {parse_light_spec("off"), parse_light_spec("E")}, {});
   double y = 0.0;
   for (int i = 0; i < 12; ++i) y += e.light(1)(1, i) * i / 11.0;
   EXPECT_NEAR(ys[0], y, 1e-5);
@@ -231,7 +269,7 @@ TEST(InteractiveShell, ScriptedSessionThroughAStream) {
 }
 
 TEST(BatchFile, WritesEveryOutputFromOneLoad) {
-  const fs::path dir = test::scratch_dir("batch");
+  const fs::path dir = spectral::test::scratch_dir("batch");
   RelightSession session(write_fixture(dir));
   std::ofstream(dir / "batch.json") << R"({
     "defaults": {"lights": {"back": "off"}},
@@ -266,7 +304,7 @@ TEST(BatchFile, WritesEveryOutputFromOneLoad) {
 TEST(RelightSession, OneSpectrumForEveryLightKeepsEachLightsScale) {
   // The scale a light has (recorded, or set before) is kept by a spec without one; a spec with one is
   // used as it is; a light that is off stays off (issue 25 item 5).
-  const fs::path dir = test::scratch_dir("every-light");
+  const fs::path dir = spectral::test::scratch_dir("every-light");
   RelightSession session(write_fixture(dir));
   session.set_light("key", "D65*0.25");
   session.set_light("", "F11");
@@ -291,7 +329,7 @@ TEST(RelightSession, OneSpectrumForEveryLightKeepsEachLightsScale) {
 }
 
 TEST(BatchFile, BadEntryStopsTheBatchBeforeAnythingIsWritten) {
-  const fs::path dir = test::scratch_dir("batchbad");
+  const fs::path dir = spectral::test::scratch_dir("batchbad");
   RelightSession session(write_fixture(dir));
   std::ofstream(dir / "batch.json") << R"({"outputs": [
       {"file": "first.exr"},
@@ -311,7 +349,7 @@ TEST(BatchFile, BadEntryStopsTheBatchBeforeAnythingIsWritten) {
 
 // issue 11: a batch bitDepth of 8.7 or 4294967304 became 8; deeply nested JSON crashed.
 TEST(BatchFile, RefusesNonIntegerBitDepthsAndDeepJson) {
-  const fs::path dir = test::scratch_dir("batchdepth");
+  const fs::path dir = spectral::test::scratch_dir("batchdepth");
   RelightSession session(write_fixture(dir));
   auto error = [&](const std::string& name, const std::string& text) {
     std::ofstream(dir / name) << text;
@@ -333,12 +371,12 @@ TEST(BatchFile, RefusesNonIntegerBitDepthsAndDeepJson) {
 }
 
 TEST(OutputImage, RejectsUnwritableAndUnknownPaths) {
-  const fs::path dir = test::scratch_dir("paths");
-  EXPECT_THROW(check_output_path(dir / "missing" / "a.png"), spectral::InputError);
-  EXPECT_THROW(check_output_path(dir / "a.gif"), spectral::InputError);  // .jpg is written since JPEG output
-  EXPECT_NO_THROW(check_output_path(dir / "a.jpg"));
-  EXPECT_THROW(check_output_path(dir), spectral::InputError);
-  EXPECT_NO_THROW(check_output_path(dir / "a.png"));
+  const fs::path dir = spectral::test::scratch_dir("paths");
+  EXPECT_THROW(spectral::check_output_path(dir / "missing" / "a.png"), spectral::InputError);
+  EXPECT_THROW(spectral::check_output_path(dir / "a.gif"), spectral::InputError);  // .jpg is written since JPEG output
+  EXPECT_NO_THROW(spectral::check_output_path(dir / "a.jpg"));
+  EXPECT_THROW(spectral::check_output_path(dir), spectral::InputError);
+  EXPECT_NO_THROW(spectral::check_output_path(dir / "a.png"));
 }
 
 }  // namespace

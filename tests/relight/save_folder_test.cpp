@@ -8,7 +8,7 @@
 
 #include "prizma/relight/save_folder.h"
 #include "prizma/spectral/error.h"
-#include "relight/relight_test_util.h"
+#include "spectral/relight_test_util.h"
 
 namespace prizma::relight {
 namespace {
@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 class SaveFolderTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = test::scratch_dir(std::string("save-folder-") +
+    dir = spectral::test::scratch_dir(std::string("save-folder-") +
                             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     served = dir / "scene.exr";
     write_text(served, "served");

@@ -4,13 +4,13 @@
 
 #include "prizma/relight/serve_state.h"
 #include "prizma/spectral/error.h"
-#include "relight/relight_test_util.h"
+#include "spectral/relight_test_util.h"
 
 namespace prizma::relight {
 namespace {
 
 RelightSession make_session() {
-  auto img = test::make_image(2, 2, spectral::BinLayout::linear(400.0, 700.0, 6), {"side", "back"},
+  auto img = spectral::test::make_image(2, 2, spectral::BinLayout::linear(400.0, 700.0, 6), {"side", "back"},
                               [](int, int, int) { return 0.5f; });
   img.info.light_records = prizma::spectral::parse_light_records(R"([{"name":"side","spectrum":"D65"},{"name":"back","spectrum":"A*0.5"}])", "test");
   return RelightSession(std::move(img), "mem.exr");

@@ -19,7 +19,7 @@
 #include "prizma/relight/terminal_image.h"
 #include "prizma/relight/terminal_preview.h"
 #include "prizma/spectral/error.h"
-#include "relight/relight_test_util.h"
+#include "spectral/relight_test_util.h"
 
 namespace prizma::relight {
 namespace {
@@ -30,7 +30,7 @@ using Words = std::vector<std::string>;
 // 6×4, lights "key" (left half grey) and "back" (right half ramp), as in relight_session_test.
 RelightSession make_session() {
   const BinLayout bins = BinLayout::linear(400.0, 700.0, 12);
-  auto img = test::make_image(6, 4, bins, {"key", "back"}, [](int l, int p, int i) {
+  auto img = spectral::test::make_image(6, 4, bins, {"key", "back"}, [](int l, int p, int i) {
     const int x = p % 6;
     if (l == 0) return x < 3 ? 0.5f : 0.0f;
     return x >= 3 ? static_cast<float>(i) / 11.0f : 0.0f;
@@ -114,7 +114,7 @@ TEST(Completion, CommandsLightsSpectraDisplaysObservers) {
 }
 
 TEST(Completion, SaveCompletesFileNames) {
-  const auto dir = test::scratch_dir("complete_files");
+  const auto dir = spectral::test::scratch_dir("complete_files");
   std::filesystem::create_directories(dir / "out folder");
   std::ofstream(dir / "lamp.csv") << "400,1\n700,1\n";
   RelightSession session = make_session();
@@ -408,7 +408,7 @@ TEST(InteractiveShell, PixelIndicesAreCheckedWithAClearError) {
 TEST(InteractiveShell, ProbeShowsTheExcitationEmissionMapOfAFluorescentPixel) {
   // relight_test_util.h's fluorescent image: 6 bins over 400–700 nm (centres 425 … 675), pairs from
   // the two blue bins into the three red ones, values 0.02·(1 + (k·7 + 3l) % 11) (k = pixel·6 + pair).
-  RelightSession session(test::fluorescent_image(), "fluor.exr");
+  RelightSession session(spectral::test::fluorescent_image(), "fluor.exr");
   int failures = 0;
   const std::string text = run(session, "probe 0 0\nprobe 0 0 sky\nprobe 0 0 nope\n", &failures);
   EXPECT_EQ(failures, 1) << text;

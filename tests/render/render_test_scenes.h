@@ -15,7 +15,6 @@
 namespace prizma::render::testing {
 
 inline constexpr double kSe = 3.0;  // tolerance of the statistical tests in standard errors (fixed seeds)
-inline constexpr double kPi = std::numbers::pi;
 
 // Every light layer (and variance layer) of a and b the same to the bit.
 inline bool same_bits(const spectral::SpectralImage& a, const spectral::SpectralImage& b) {

@@ -7,6 +7,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <numbers>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -20,7 +21,6 @@
 namespace prizma::render {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A w × h map of `dim` everywhere but texel (x, y) = `bright`.
 EnvironmentMap one_texel(int w, int h, int x, int y, EnvironmentConvention c, double rotation_deg = 0.0,
@@ -48,7 +48,7 @@ Eigen::Vector3d mean_draw(const EnvironmentMap& m, double& spread_deg) {
   }
   const Eigen::Vector3d mean = sum.normalized();
   spread_deg = 0.0;
-  for (const auto& d : draws) spread_deg = std::max(spread_deg, std::acos(std::clamp(d.dot(mean), -1.0, 1.0)) * 180.0 / kPi);
+  for (const auto& d : draws) spread_deg = std::max(spread_deg, std::acos(std::clamp(d.dot(mean), -1.0, 1.0)) * 180.0 / std::numbers::pi);
   return mean;
 }
 
@@ -56,7 +56,7 @@ TEST(EnvironmentConventions, PrizmaAndMitsubaLatLongTexelsLandWhereTheirFormulas
   // 8 × 4 texels; texel (6, 1) spans u ∈ [¾, ⅞), v ∈ [¼, ½): Prizma's φ = 2π(u − ½) ∈ [π/2, 3π/4),
   // θ ∈ [π/4, π/2): around +x, tilted toward +z and up. Mitsuba's φ = 2πu puts the same texel
   // 180° about +y from it: around −x, tilted toward −z.
-  const double theta = 3.0 * kPi / 8.0, phi = 5.0 * kPi / 8.0;  // the texel's centre
+  const double theta = 3.0 * std::numbers::pi / 8.0, phi = 5.0 * std::numbers::pi / 8.0;  // the texel's centre
   const Eigen::Vector3d prizma_centre(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
   const Eigen::Vector3d mitsuba_centre(-prizma_centre.x(), prizma_centre.y(), -prizma_centre.z());
   const EnvironmentMap p = one_texel(8, 4, 6, 1, EnvironmentConvention::Prizma);
@@ -67,9 +67,9 @@ TEST(EnvironmentConventions, PrizmaAndMitsubaLatLongTexelsLandWhereTheirFormulas
   EXPECT_EQ(m.radiance(prizma_centre), 0.0);
   // Mitsuba 3's envmap: u = atan2(x, −z) / 2π mod 1, v = acos(y) / π (emitters/envmap.cpp).
   const Eigen::Vector3d d = unit(0.3, -0.4, 0.8);
-  double u = std::atan2(d.x(), -d.z()) / (2.0 * kPi);
+  double u = std::atan2(d.x(), -d.z()) / (2.0 * std::numbers::pi);
   u -= std::floor(u);
-  const int col = static_cast<int>(u * 8), row = static_cast<int>(std::acos(d.y()) / kPi * 4);
+  const int col = static_cast<int>(u * 8), row = static_cast<int>(std::acos(d.y()) / std::numbers::pi * 4);
   EXPECT_EQ(one_texel(8, 4, col, row, EnvironmentConvention::Mitsuba).radiance(d), 1.0) << col << " " << row;
   // Every direction: Mitsuba's map is Prizma's turned 180° about +y.
   std::vector<float> v(32);
@@ -82,7 +82,7 @@ TEST(EnvironmentConventions, PrizmaAndMitsubaLatLongTexelsLandWhereTheirFormulas
     EXPECT_EQ(mp.radiance(dir), pp.radiance(dir)) << dir.transpose();
   }
   double spread = 0.0;
-  EXPECT_GT(mean_draw(m, spread).dot(mitsuba_centre), std::cos(25.0 * kPi / 180.0));
+  EXPECT_GT(mean_draw(m, spread).dot(mitsuba_centre), std::cos(25.0 * std::numbers::pi / 180.0));
   EXPECT_LT(spread, 35.0);
 }
 
@@ -126,7 +126,7 @@ TEST(EnvironmentConventions, EqualAreaDensityIntegratesToOneAndEveryTexelHasTheS
     Eigen::Vector3d d;
     double radiance = 0.0;
     const double pdf = one.sample(rng.uniform_double(), rng.uniform_double(), d, radiance);
-    EXPECT_NEAR(pdf, n * n / (4.0 * kPi), 1e-9);
+    EXPECT_NEAR(pdf, n * n / (4.0 * std::numbers::pi), 1e-9);
     EXPECT_NEAR(one.pdf(d), pdf, 1e-9);
   }
   std::vector<float> v(static_cast<std::size_t>(n) * n);
@@ -151,7 +151,7 @@ TEST(EnvironmentConventions, EqualAreaDensityIntegratesToOneAndEveryTexelHasTheS
       EXPECT_EQ(map.radiance(d), radiance);
     }
     if (radiance > 0.0) {
-      EXPECT_NEAR(radiance / pdf, 4.0 * kPi * mean_l, 1e-9 * mean_l);
+      EXPECT_NEAR(radiance / pdf, 4.0 * std::numbers::pi * mean_l, 1e-9 * mean_l);
     }
   }
 }

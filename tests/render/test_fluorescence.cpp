@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -25,7 +26,6 @@ namespace {
 using spectral::Spectrum;
 using testing::box_scene;
 using testing::grey_material;
-using testing::kPi;
 using testing::kSe;
 
 // σf per unit: 2 at 400 nm falling to 0 at 500 nm (zero outside the table).
@@ -89,7 +89,7 @@ double closed_form(const spectral::BinLayout& bins, const spectral::BinPair& pr,
   const double out_avg =
       integrate([&](double l) { return rho.eval(l) / l; }, bins.lo_nm(pr.out), bins.hi_nm(pr.out)) / bins.width_nm(pr.out);
   const double in_int = integrate([&](double l) { return l * f(sf.eval(l)); }, bins.lo_nm(pr.in), bins.hi_nm(pr.in));
-  return q / (4.0 * kPi) * out_avg * in_int;
+  return q / (4.0 * std::numbers::pi) * out_avg * in_int;
 }
 
 Scene dye_box(const Material& m, Eigen::Vector3d light_dir, std::int64_t spp) {
@@ -338,7 +338,7 @@ double overlap_pair(int out, int in, const spectral::BinLayout& bins) {
   };
   // The kink of |μ| at 0: each half by Gauss–Legendre.
   const double j = 0.5 * (testing::integrate(g, -1.0, 0.0) + testing::integrate(g, 0.0, 1.0));
-  return a * b * std::exp(-sigma * thickness) / (4.0 * kPi) * (thickness + c * j);
+  return a * b * std::exp(-sigma * thickness) / (4.0 * std::numbers::pi) * (thickness + c * j);
 }
 
 // Per excitation bin of in_bins, Σ_out M[out][in] (the diagonal term from the T layer) of light 0.

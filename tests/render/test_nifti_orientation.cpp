@@ -5,6 +5,7 @@
 #include <nifti1_io.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "prizma/render/render.h"
 #include "prizma/render/volume.h"
@@ -159,7 +160,7 @@ TEST(NiftiOrientation, AnObliqueFileIsSnappedWithAWarningEveryRender) {
   // An sform turned 10° about the superior axis: the axes snap to R, A, S and the volume's
   // warnings (printed by prizma-render without --verbose, returned by prizma.render) say by how much.
   ScratchDir dir;
-  const float c = std::cos(10.0f * 3.14159265f / 180.0f), s = std::sin(10.0f * 3.14159265f / 180.0f);
+  const float c = std::cos(10.0f * std::numbers::pi_v<float> / 180.0f), s = std::sin(10.0f * std::numbers::pi_v<float> / 180.0f);
   write_oriented(dir / "oblique.nii", {2, 2, 2}, {1, 1, 1}, {1, affine({{{c, -s, 0, 0}, {s, c, 0, 0}, {0, 0, 1, 0}}})}, 0,
                  {0, 0, 0, 1}, index_values(8));
   const Volume vol = load_nifti_volume(dir / "oblique.nii");

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "prizma/render/phase.h"
@@ -17,7 +18,7 @@ namespace prizma::render {
 namespace {
 
 using spectral::Spectrum;
-using namespace testing;  // render_test_scenes.h (scenes, pixel averages, kSe, kPi), transfer_references.h
+using namespace testing;  // render_test_scenes.h (scenes, pixel averages, kSe), transfer_references.h
 
 TEST(RenderDirectional, HFunctionSolvesChandrasekharsEquation) {
   // Self-checks of the reference: the converged H satisfies the H-equation in its original form,
@@ -41,8 +42,8 @@ TEST(RenderDirectional, HalfSpaceReflectionSolvesTheIsotropicCaseAndTheSingleSca
   for (double w : {0.5, 0.9}) {
     const HFunction h(w);
     for (double mu0 : {1.0, 0.5}) {
-      const double want = w * mu0 * h(1.0) * h(mu0) / (4.0 * kPi * (1.0 + mu0));
-      EXPECT_NEAR(HalfSpaceReflection(w, [](double) { return 1.0 / (4.0 * kPi); }, mu0).radiance(), want, 1e-6 * want)
+      const double want = w * mu0 * h(1.0) * h(mu0) / (4.0 * std::numbers::pi * (1.0 + mu0));
+      EXPECT_NEAR(HalfSpaceReflection(w, [](double) { return 1.0 / (4.0 * std::numbers::pi); }, mu0).radiance(), want, 1e-6 * want)
           << "albedo " << w << " mu0 " << mu0;
     }
   }
@@ -57,7 +58,7 @@ TEST(RenderDirectional, SingleScatteringFromASlabMatchesTheClosedForm) {
   // (μ0 = cos θ0) of unit irradiance, seen straight down. Integrating along the view ray, the
   // radiance is ω p(−μ0) ∫₀ᴰ σt e^{−σt s (1 + 1/μ0)} ds = ω p(−μ0) (1 − e^{−τ(1 + 1/μ0)}) / (1 + 1/μ0)
   // with τ = σt·D; the bin value is its average over λ in the bin (Gauss–Legendre).
-  const double w = 0.7, g = 0.5, theta0 = 20.0 * kPi / 180.0, mu0 = std::cos(theta0);
+  const double w = 0.7, g = 0.5, theta0 = 20.0 * std::numbers::pi / 180.0, mu0 = std::cos(theta0);
   Scene s = window_scene(make_material(Spectrum::constant(w), Spectrum({400.0, 700.0}, {0.05, 0.5}),
                                        Spectrum::constant(g)),
                          testing::directional_light("sun", {std::sin(theta0), 0.0, mu0}), 16, 128);
@@ -85,15 +86,15 @@ TEST(RenderDirectional, ConeLightSingleScatteringMatchesTheClosedForm) {
   // same kind of slab, grey: σt = 0.3, albedo 0.8, g = 0.3, single scattering, seen straight down.
   // Summing the slab formula over the cone's directions (azimuthal symmetry about the view axis):
   //   L = (ω/Ω) ∫_{cos α}^{1} 2π p(−μ') (1 − e^{−τ(1 + 1/μ')}) / (1 + 1/μ') dμ'.
-  const double w = 0.8, g = 0.3, tau = 0.3, alpha = 20.0 * kPi / 180.0;
+  const double w = 0.8, g = 0.3, tau = 0.3, alpha = 20.0 * std::numbers::pi / 180.0;
   Scene s = window_scene(grey_material(w, tau, g), testing::directional_light("cone", {0, 0, 1}, 40.0), 16, 128);
   s.settings.max_bounces = 1;
   s.settings.seed = 12;
   const auto e = pixel_average(render(s), 0);
-  const double omega = 2.0 * kPi * (1.0 - std::cos(alpha));
+  const double omega = 2.0 * std::numbers::pi * (1.0 - std::cos(alpha));
   const double expected = w / omega * integrate([&](double mu) {
     const double k = 1.0 + 1.0 / mu;
-    return 2.0 * kPi * hg(-mu, g) * (1.0 - std::exp(-tau * k)) / k;
+    return 2.0 * std::numbers::pi * hg(-mu, g) * (1.0 - std::exp(-tau * k)) / k;
   }, std::cos(alpha), 1.0);
   for (int b = 0; b < 6; ++b) {
     EXPECT_NEAR(e.mean[b], expected, kSe * e.se[b]) << "bin " << b << ": " << e.mean[b] << " ± " << e.se[b];
@@ -109,13 +110,13 @@ TEST(RenderDirectional, IsotropicHalfSpaceMatchesChandrasekharsHFunction) {
   // around the viewed window (a half-space to far below the noise), seen straight down (μ = 1).
   for (const double w : {0.5, 0.9}) {
     for (const double theta0_deg : {0.0, 60.0}) {
-      const double theta0 = theta0_deg * kPi / 180.0, mu0 = std::cos(theta0);
+      const double theta0 = theta0_deg * std::numbers::pi / 180.0, mu0 = std::cos(theta0);
       Scene s = window_scene(grey_material(w, 400.0, 0.0),
                              testing::directional_light("sun", {std::sin(theta0), 0.0, mu0}), 16, 128);
       s.settings.seed = 13;
       const auto e = pixel_average(render(s), 0);
       const HFunction h(w);
-      const double expected = w * mu0 * h(1.0) * h(mu0) / (4.0 * kPi * (1.0 + mu0));
+      const double expected = w * mu0 * h(1.0) * h(mu0) / (4.0 * std::numbers::pi * (1.0 + mu0));
       for (int b = 0; b < 6; ++b) {
         EXPECT_NEAR(e.mean[b], expected, kSe * e.se[b])
             << "albedo " << w << " θ0 " << theta0_deg << " bin " << b << ": " << e.mean[b] << " ± " << e.se[b];
@@ -141,7 +142,7 @@ TEST(RenderDirectional, SignedAnisotropyTableMatchesTheHalfSpaceReflection) {
   ctx.values = spectral::SpectrumValues::Signed;
   const Spectrum table = spectral::parse_spectrum("csv:" + dir.write("g.csv", csv).string(), ctx);
   ASSERT_DOUBLE_EQ(table.eval(425.0), -0.7);
-  const double w = 0.9, theta0 = 60.0 * kPi / 180.0, mu0 = std::cos(theta0);
+  const double w = 0.9, theta0 = 60.0 * std::numbers::pi / 180.0, mu0 = std::cos(theta0);
   Scene s = window_scene(make_material(Spectrum::constant(w), Spectrum::constant(400.0), table),
                          testing::directional_light("sun", {std::sin(theta0), 0.0, mu0}), 16, 128);
   s.settings.seed = 14;

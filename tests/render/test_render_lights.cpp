@@ -22,7 +22,7 @@ namespace prizma::render {
 namespace {
 
 using spectral::Spectrum;
-using namespace testing;  // render_test_scenes.h: the box scene, materials, pixel averages, kSe, kPi
+using namespace testing;  // render_test_scenes.h: the box scene, materials, pixel averages, kSe
 
 Light point_light(std::string name, Eigen::Vector3d position, double radius = 0.0) {
   Light l;
@@ -87,7 +87,7 @@ Scene slab_scene(const Light& light, std::int64_t spp, double window = 0.01) {
 // 1/4π), whose light crosses σt·z of the scatterer and a·½ of the absorber over r = z + 1, so
 // every single-scatter path has the same attenuation e^{−(σt/2 + a/2)} = e^{−τ}, τ = 1.5, and
 //   L = σs/(4π) · e^{−τ} · ∫₀^½ dz / (z + 1)² = σs/(4π) · e^{−τ} · (1 − 1/1.5) = σs e^{−τ} / (12π).
-double slab_closed_form() { return 0.8 * std::exp(-1.5) / (12.0 * kPi); }
+double slab_closed_form() { return 0.8 * std::exp(-1.5) / (12.0 * std::numbers::pi); }
 
 TEST(RenderLights, PointLightThroughAnAbsorbingSlabMatchesTheClosedForm) {
   const double expected = slab_closed_form();
@@ -104,7 +104,7 @@ TEST(RenderLights, PointLightThroughAnAbsorbingSlabMatchesTheClosedForm) {
   Scene far = slab_scene(point_light("bulb", {0, 0, -2}), 2048);
   far.settings.seed = 22;
   const auto f = pixel_average(render(far), 0);
-  EXPECT_NEAR(f.mean[0], 0.8 * std::exp(-1.5) * 0.1 / (4.0 * kPi), kSe * f.se[0]);
+  EXPECT_NEAR(f.mean[0], 0.8 * std::exp(-1.5) * 0.1 / (4.0 * std::numbers::pi), kSe * f.se[0]);
 }
 
 TEST(RenderLights, TinySphereLightIsThePointLight) {
@@ -146,7 +146,7 @@ TEST(RenderLights, SphereLightSendsNothingInside) {
 }
 
 TEST(RenderLights, SpotFalloffFollowsPbrtsSmoothstep) {
-  const double outer = std::cos(30.0 * kPi / 180.0), inner = std::cos(20.0 * kPi / 180.0);
+  const double outer = std::cos(30.0 * std::numbers::pi / 180.0), inner = std::cos(20.0 * std::numbers::pi / 180.0);
   EXPECT_EQ(spot_falloff(1.0, outer, inner), 1.0);
   EXPECT_EQ(spot_falloff(inner, outer, inner), 1.0);
   EXPECT_EQ(spot_falloff(outer, outer, inner), 0.0);
@@ -175,10 +175,10 @@ TEST(RenderLights, SpotLightIsThePointLightTimesItsProfile) {
   Scene point = slab_scene(point_light("bulb", {0, 0, -1}), 64, window);
   const auto ref = pixel_average(render(point), 0);
   for (double alpha_deg : {0.0, 10.0, 19.0, 22.0, 25.0, 28.0, 31.0, 60.0}) {
-    const double a = alpha_deg * kPi / 180.0;
+    const double a = alpha_deg * std::numbers::pi / 180.0;
     Scene spot = slab_scene(spot_light("spot", {0, 0, -1}, {std::sin(a), 0.0, std::cos(a)}, 30.0, 10.0), 64, window);
     const auto e = pixel_average(render(spot), 0);
-    const double profile = spot_falloff(std::cos(a), std::cos(30.0 * kPi / 180.0), std::cos(20.0 * kPi / 180.0));
+    const double profile = spot_falloff(std::cos(a), std::cos(30.0 * std::numbers::pi / 180.0), std::cos(20.0 * std::numbers::pi / 180.0));
     for (int b = 0; b < 6; ++b) {
       if (profile == 0.0) {
         EXPECT_EQ(e.mean[b], 0.0) << alpha_deg << "°";
@@ -337,8 +337,8 @@ TEST(EnvironmentMap, DensityIntegratesToOneAndMatchesItsSamples) {
   double exact = 0.0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      exact += v[static_cast<std::size_t>(y) * w + x] * (2.0 * kPi / w) *
-               (std::cos(kPi * y / h) - std::cos(kPi * (y + 1) / h));
+      exact += v[static_cast<std::size_t>(y) * w + x] * (2.0 * std::numbers::pi / w) *
+               (std::cos(std::numbers::pi * y / h) - std::cos(std::numbers::pi * (y + 1) / h));
   Rng rng(5, 0, 0);
   double sum = 0.0, sum2 = 0.0;
   const int n = 200000;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstring>
 #include <random>
 #include <set>
@@ -32,7 +33,6 @@ namespace {
 using spectral::Spectrum;
 using testing::box_scene;
 using testing::hg;
-using testing::kPi;
 using testing::kSe;
 using testing::make_material;
 using testing::pixel_average;
@@ -235,7 +235,7 @@ TEST(SpectralMis, HalfSpaceWithSpectralAlbedoAnisotropyAndExtinction) {
     }
     return Spectrum(l, y);
   };
-  const double theta0 = 60.0 * kPi / 180.0, mu0 = std::cos(theta0);
+  const double theta0 = 60.0 * std::numbers::pi / 180.0, mu0 = std::cos(theta0);
   std::vector<double> expected(6);
   for (int b = 0; b < 6; ++b) {
     const double gb = g[b];

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <set>
 #include <vector>
 
@@ -26,7 +27,7 @@ TEST(TracerPhase, HgIsNormalised) {
     const int n = 200000;
     double sum = 0;
     for (int k = 0; k < n; ++k) sum += hg_phase(static_cast<float>(-1.0 + (k + 0.5) * 2.0 / n), static_cast<float>(g));
-    EXPECT_NEAR(sum * 2.0 / n * 2.0 * 3.14159265358979323846, 1.0, 2e-3) << g;
+    EXPECT_NEAR(sum * 2.0 / n * 2.0 * std::numbers::pi, 1.0, 2e-3) << g;
   }
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "prizma/render/volume.h"
 #include "prizma/spectral/error.h"
@@ -41,7 +42,7 @@ TEST(ProceduralVolume, CubeSphereVolumeFractions) {
     cube += x == 100.0f;
   }
   const double n = static_cast<double>(v.values.size());
-  const double sphere_exact = 4.0 / 3.0 * M_PI * 0.125 / 8.0;
+  const double sphere_exact = 4.0 / 3.0 * std::numbers::pi * 0.125 / 8.0;
   EXPECT_NEAR(sphere / n, sphere_exact, 1.57 / res);
   EXPECT_NEAR((cube + sphere) / n, 1.6 * 1.6 * 1.6 / 8.0, 1.92 / res);
   EXPECT_GT(cube, 0.0);

@@ -11,26 +11,13 @@
 #include "prizma/spectral/light_design.h"
 #include "prizma/spectral/metamer_design.h"
 #include "prizma/spectral/spectrum_spec.h"
+#include "spectral/independent_colour.h"
 
 namespace prizma::spectral {
 namespace {
 
-Eigen::Vector3d independent_xyz(const Spectrum& reflectance, const Spectrum& light, bool absolute = false) {
-  std::vector<double> lambda, product, energy;
-  for (int nm = 380; nm <= 780; ++nm) {
-    lambda.push_back(nm);
-    product.push_back(light.eval(nm) * reflectance.eval(nm));
-    energy.push_back(light.eval(nm));
-  }
-  const ColorMatching& cmf = ColorMatching::get(Observer::Cie1931_2deg);
-  const Eigen::Vector3d xyz = cmf.integrate(Spectrum(lambda, product));
-  return absolute ? xyz : Eigen::Vector3d(xyz / cmf.integrate(Spectrum(lambda, energy)).y());
-}
-
-double independent_delta_e(const Spectrum& a, const Spectrum& b, const Spectrum& light) {
-  const Eigen::Vector3d white = independent_xyz(Spectrum::constant(1.0), light);
-  return delta_e2000(xyz_to_lab(independent_xyz(a, light), white), xyz_to_lab(independent_xyz(b, light), white));
-}
+using test::independent_delta_e;
+using test::independent_xyz;
 
 // A pair that matches under A and differs under D65: the hiding light exists (A is one).
 struct Pair {

@@ -10,26 +10,12 @@
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/metamer_design.h"
 #include "prizma/spectral/spectrum_spec.h"
+#include "spectral/independent_colour.h"
 
 namespace prizma::spectral {
 namespace {
 
-// White-normalised XYZ over 380–780 nm: ∫E·r·cmf / ∫E·ȳ with both products tabulated every 1 nm.
-Eigen::Vector3d independent_xyz(const Spectrum& reflectance, const Spectrum& light) {
-  std::vector<double> lambda, product, energy;
-  for (int nm = 380; nm <= 780; ++nm) {
-    lambda.push_back(nm);
-    product.push_back(light.eval(nm) * reflectance.eval(nm));
-    energy.push_back(light.eval(nm));
-  }
-  const ColorMatching& cmf = ColorMatching::get(Observer::Cie1931_2deg);
-  return cmf.integrate(Spectrum(lambda, product)) / cmf.integrate(Spectrum(lambda, energy)).y();
-}
-
-double independent_delta_e(const Spectrum& a, const Spectrum& b, const Spectrum& light) {
-  const Eigen::Vector3d white = independent_xyz(Spectrum::constant(1.0), light);
-  return delta_e2000(xyz_to_lab(independent_xyz(a, light), white), xyz_to_lab(independent_xyz(b, light), white));
-}
+using test::independent_delta_e;
 
 TEST(MetamerDesign, MatchesUnderD65AndSplitsUnderA) {
   const Spectrum albedo = parse_spectrum("cc:4");

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -160,7 +161,7 @@ TEST(SpectrumSpec, Gaussian) {
   const auto& lam = g.wavelengths_nm();
   for (std::size_t i = 1; i < lam.size(); ++i) EXPECT_LE(lam[i] - lam[i - 1], 20.0 / 40.0 + 1e-12);
   // Area σ√(2π); the piecewise-linear error at step FWHM/40 is ≈ 1e-4 relative.
-  EXPECT_NEAR(g.integrate(0, 1000), sigma * std::sqrt(2 * M_PI), 2e-4 * sigma * std::sqrt(2 * M_PI));
+  EXPECT_NEAR(g.integrate(0, 1000), sigma * std::sqrt(2 * std::numbers::pi), 2e-4 * sigma * std::sqrt(2 * std::numbers::pi));
   expect_spec_error("gaussian:550", "expected gaussian:<centre>:<fwhm>");
   expect_spec_error("gaussian:550:20:3", "expected gaussian:<centre>:<fwhm>");
   expect_spec_error("gaussian:550:0", "FWHM");

@@ -6,9 +6,9 @@
 #include <limits>
 #include <unistd.h>
 
-#include "prizma/relight/light_spec.h"
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
+#include "prizma/spectral/light_spectrum.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
 #include "prizma/spectral/error.h"
 #include "stress/stress_support.h"
 
@@ -38,15 +38,15 @@ TEST(StressRelight, LightScales1em6To1e6AreLinearAndFinite) {
   const ps::SpectralImage img = pr::render(small_chromatic_scene());
   for (const std::string base : {"D65", "F11", "LED-B3", "gaussian:550:10"}) {
     auto relit = [&](const std::string& scale) {
-      std::vector<relight::LightSpec> specs;
+      std::vector<spectral::LightSpectrum> specs;
       for (std::size_t l = 0; l < img.lights.size(); ++l)
-        specs.push_back(relight::parse_light_spec(scale.empty() ? base : base + "*" + scale));
-      return relight::relight_image(img, relight::RelightMatrix(img.bins, specs, relight::RelightOptions{}));
+        specs.push_back(spectral::parse_light_spectrum(scale.empty() ? base : base + "*" + scale));
+      return spectral::relight_image(img, spectral::RelightMatrix(img.bins, specs, spectral::RelightOptions{}));
     };
-    const relight::XyzImage ref = relit("");
+    const spectral::XyzImage ref = relit("");
     for (const std::string scale : {"1e-6", "1e-3", "1e3", "1e6"}) {
       const double k = std::stod(scale);
-      const relight::XyzImage x = relit(scale);
+      const spectral::XyzImage x = relit(scale);
       std::size_t bad = 0, nonlinear = 0;
       for (std::size_t i = 0; i < x.xyz.size(); ++i) {
         if (!std::isfinite(x.xyz[i]) || x.xyz[i] < 0.0f) ++bad;

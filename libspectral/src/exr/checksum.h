@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "exr/exr_common.h"
-#include "float_hash.h"
+#include "prizma/spectral/fnv1a.h"
 #include "prizma/spectral/spectral_exr.h"
 
 namespace prizma::spectral::exr {
@@ -18,10 +18,13 @@ namespace prizma::spectral::exr {
 inline constexpr const char* kChecksumScheme = "fnv1a64-words-v2:";
 inline constexpr const char* kChecksumSchemeV1 = "fnv1a64-words:";
 
-// One layer's term: FNV-1a over n values (float or half) from its kind's offset basis.
+// One layer's term: FNV-1a over n values (float or half; one 32-bit word each) from its kind's
+// offset basis. The terms are summed modulo 2⁶⁴ by the caller, so their order does not matter.
 template <class Value>
 std::uint64_t layer_hash(LayerKind kind, const Value* values, std::size_t n) {
-  return detail::hash_float_bits(values, n, layer_kind(kind).checksum_basis);
+  Fnv1a h(layer_kind(kind).checksum_basis);
+  h.add_float_words(values, n);
+  return h.value();
 }
 
 std::string checksum_string(std::uint64_t sum, const char* scheme = kChecksumScheme);

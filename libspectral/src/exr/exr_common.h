@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "prizma/spectral/fnv1a.h"
 #include "prizma/spectral/spectral_exr.h"
 
 namespace prizma::spectral::exr {
@@ -34,8 +35,8 @@ inline constexpr const char* kVarianceLayer = "var";
 inline constexpr float kHalfMax = 65504.0f;
 
 // The kinds of channel sets a Prizma file holds (docs/spectral-exr.md), each with its term of
-// prizma:checksum: FNV-1a 64 over the values as a reader gets them (float_hash.h) from the kind's own
-// offset basis, the terms summed modulo 2⁶⁴. One row per kind, so a new kind (the denoiser's guide
+// prizma:checksum: FNV-1a 64 over the values as a reader gets them (prizma/spectral/fnv1a.h, the
+// scene hash's FNV-1a too) from the kind's own offset basis, the terms summed modulo 2⁶⁴. One row per kind, so a new kind (the denoiser's guide
 // layers) is a row here and its own reader and writer, not a branch in every loop.
 enum class LayerKind : unsigned char {
   Transport,     // a light's bins (T.<λ>nm, or <light>.T.<λ>nm)
@@ -52,7 +53,7 @@ struct LayerKindInfo {
   std::uint64_t checksum_basis;  // FNV-1a offset basis of its checksum term; 0: not in the checksum
 };
 inline constexpr LayerKindInfo kLayerKinds[] = {
-    {LayerKind::Transport, "light", 0xcbf29ce484222325ULL},
+    {LayerKind::Transport, "light", kFnv1aOffsetBasis},  // 0xcbf29ce484222325; the others are it rotated
     {LayerKind::Sum, "sum of all lights", 0xe4842223cbf2925cULL},
     {LayerKind::Variance, "variance of light", 0x84222325cbf29ce4ULL},
     {LayerKind::Bispectral, "bispectral terms of light", 0x2325cbf29ce48422ULL},

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "prizma/relight/output_image.h"
+#include "prizma/spectral/output_image.h"
 
 namespace prizma::relight {
 

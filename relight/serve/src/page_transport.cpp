@@ -119,7 +119,7 @@ std::string PageTransport::layer(int light, int group, bool half, spectral::Obse
   }
   const std::lock_guard lock(m_mutex);
   auto it = m_reradiation.find(cmf);
-  if (it == m_reradiation.end()) it = m_reradiation.emplace(cmf, reradiation_weights(img, cmf)).first;
+  if (it == m_reradiation.end()) it = m_reradiation.emplace(cmf, spectral::reradiation_weights(img, cmf)).first;
   const std::vector<float>& k = it->second.per_light[l];
   const int n = 3 * static_cast<int>(it->second.in_bins.size());
   return texels(pixels, n, group - groups(), half, [&](std::size_t p, int i, bool as_half, char* at) {
@@ -129,10 +129,10 @@ std::string PageTransport::layer(int light, int group, bool half, spectral::Obse
 
 json PageTransport::weights(const RelightSettings& s) const {
   const auto& img = m_session.image();
-  const RelightMatrix m(img.bins, s.lights, s.relight);
+  const spectral::RelightMatrix m(img.bins, s.lights, s.relight);
   const CompressedTransport* c = m_session.coefficients();
   const std::vector<std::vector<float>> folded = c ? coefficient_weights(*c, m) : std::vector<std::vector<float>>{};
-  ReradiationWeights in_bins;  // only the in bins: the weights of K do not depend on K
+  spectral::ReradiationWeights in_bins;  // only the in bins: the weights of K do not depend on K
   in_bins.in_bins = spectral::reradiation_in_bins(img);
   json lights = json::array();
   for (int l = 0; l < m.light_count(); ++l) {
@@ -143,7 +143,7 @@ json PageTransport::weights(const RelightSettings& s) const {
       light["on"] = !folded[index].empty();
       light["w"] = folded[index].empty() ? std::vector<float>(3 * static_cast<std::size_t>(k), 0.0f) : folded[index];
     } else {
-      const Matrix3Xd& w = m.light(l);
+      const spectral::Matrix3Xd& w = m.light(l);
       std::vector<double> rows;  // row-major X, Y, Z rows of n weights
       for (int r = 0; r < 3; ++r)
         for (int i = 0; i < m.bin_count(); ++i) rows.push_back(w(r, i));
@@ -151,7 +151,7 @@ json PageTransport::weights(const RelightSettings& s) const {
       light["w"] = rows;
     }
     // Bispectral: the weights of K (3 × 3·|in|, row-major), what relight_into uses (relight_image.h).
-    if (!img.reradiation.empty()) light["wr"] = reradiation_term_weights(m, in_bins, l).weights;
+    if (!img.reradiation.empty()) light["wr"] = spectral::reradiation_term_weights(m, in_bins, l).weights;
     lights.push_back(std::move(light));
   }
   const Eigen::Vector3d white = m.mix_white_xyz();

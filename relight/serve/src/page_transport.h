@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/relight/relight_session.h"
 
 namespace prizma::relight {
@@ -49,7 +49,7 @@ class PageTransport {
  private:
   const RelightSession& m_session;
   std::mutex m_mutex;  // guards the cache of K
-  std::map<spectral::Observer, ReradiationWeights> m_reradiation;  // per observer, on first use
+  std::map<spectral::Observer, spectral::ReradiationWeights> m_reradiation;  // per observer, on first use
 };
 
 }  // namespace prizma::relight

@@ -7,7 +7,7 @@
 #include <cerrno>
 #include <regex>
 
-#include "prizma/relight/output_image.h"
+#include "prizma/spectral/output_image.h"
 #include "prizma/spectral/error.h"
 
 namespace prizma::relight {
@@ -42,7 +42,7 @@ fs::path SaveFolder::save(const std::string& name, const std::function<void(cons
   if (!std::regex_match(name, kSaveName)) {
     throw InputError("file", "\"" + name + "\" is not a plain file name (letters, digits, '.', '_', '-')");
   }
-  output_format_for(name, "file");
+  spectral::output_format_for(name, "file");
   const fs::path path = m_folder / name;
   struct stat st{};
   const bool exists = ::lstat(path.c_str(), &st) == 0;

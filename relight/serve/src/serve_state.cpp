@@ -77,9 +77,7 @@ RelightSettings settings_from_state(const StateParams& params, const RelightSess
         s.lights[l] = parse_light_spec(value, {"state: " + key, {}});
       }
     } else if (key == "exposure") {
-      const double ev = parse_number(key, value);
-      if (std::abs(ev) > 64.0) throw InputError("state: exposure", "must be within ±64 stops");
-      s.relight.exposure_ev = ev;
+      s.relight.exposure_ev = parse_number(key, value);
     } else if (key == "cmf") {
       s.relight.cmf = spectral::parse_observer(value, "state: cmf");
     } else if (key == "display") {
@@ -91,6 +89,9 @@ RelightSettings settings_from_state(const StateParams& params, const RelightSess
       throw InputError("state: " + key, "unknown key (known: light.NAME, exposure, cmf, display, adapt)");
     }
   }
+  RelightSettingNames names;  // the page sets no bit depth
+  names.exposure = "state: exposure";
+  s.validate(names);
   return s;
 }
 

@@ -177,9 +177,9 @@ class Shell {
     if (protocol != ImageProtocol::Blocks && m_opts.image_route) route = m_opts.image_route(protocol);
     if (!route.shown) throw InputError(std::string("show ") + image_protocol_name(protocol), route.why);
     const TerminalSize size = m_opts.terminal_size ? m_opts.terminal_size() : m_opts.terminal;
-    const XyzImage& img = m_session.xyz();
+    const spectral::XyzImage& img = m_session.xyz();
     m_out << std::flush;
-    draw_terminal_image(m_out, to_display(img, m_session.display()), img.width, img.height, protocol, size, 3,
+    draw_terminal_image(m_out, spectral::to_display(img, m_session.display()), img.width, img.height, protocol, size, 3,
                         route.tmux_passthrough);
     if (route.tmux_passthrough) m_out << "(kitty graphics through tmux's passthrough: tmux neither moves nor clears them)\n";
   }

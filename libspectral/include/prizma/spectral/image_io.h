@@ -48,10 +48,6 @@ struct PictureColourSpace {
 // 0 (RGB), full range 1. Nothing for a table curve or other primaries.
 std::optional<std::array<std::uint8_t, 4>> cicp_code_points(const PictureColourSpace& cs);
 
-// sRGB as IEC 61966-2-1 defines it (Rec. 709 primaries, D65, the piecewise curve; cICP 1, 13, 0, 1):
-// the colour space of pictures encoded without OpenColorIO (prizma-render --preview).
-PictureColourSpace srgb_picture_colour_space();
-
 struct PictureSpec {
   int width = 0;
   int height = 0;

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "prizma/relight/relight_matrix.h"
-#include "prizma/relight/xyz_image.h"
+#include "prizma/spectral/relight_matrix.h"
+#include "prizma/spectral/xyz_image.h"
 #include "prizma/spectral/display.h"
 #include "prizma/spectral/spectral_basis.h"
 #include "prizma/spectral/spectral_exr.h"
@@ -84,13 +84,14 @@ CompressedTransport compress_spectral_exr(const std::filesystem::path& input, co
 // The weights relight_compressed_into multiplies each light's coefficients by: W_l = M_l·B_l, 3×k_l
 // as float, row-major (X, Y, Z rows); empty for a light that is off. The live page's shader uses these
 // very numbers. Throws as relight_compressed_into when the matrix does not match the transport.
-std::vector<std::vector<float>> coefficient_weights(const CompressedTransport& transport, const RelightMatrix& matrix);
+std::vector<std::vector<float>> coefficient_weights(const CompressedTransport& transport, const spectral::RelightMatrix& matrix);
 
 // XYZ = Σ_l (M_l·B_l)·c_l for every pixel (TBB over rows; independent of the thread count). Throws
 // RuntimeError when the matrix does not match the transport's lights or bins, or a layer's sizes
 // are inconsistent.
-void relight_compressed_into(const CompressedTransport& transport, const RelightMatrix& matrix, float* xyz_out);
-XyzImage relight_compressed(const CompressedTransport& transport, const RelightMatrix& matrix);
+void relight_compressed_into(const CompressedTransport& transport, const spectral::RelightMatrix& matrix,
+                             float* xyz_out);
+spectral::XyzImage relight_compressed(const CompressedTransport& transport, const spectral::RelightMatrix& matrix);
 
 class DisplayEncoder8;
 
@@ -100,10 +101,10 @@ class DisplayEncoder8;
 // The codes equal encoder.encode(relight_compressed_into(...)) within one (float rounding of the
 // folded matrix), and do not depend on the thread count. Needs a baked encoder with a step table;
 // otherwise it relights to XYZ and calls encode() (same codes, slower).
-void relight_compressed_to_display8(const CompressedTransport& transport, const RelightMatrix& matrix,
+void relight_compressed_to_display8(const CompressedTransport& transport, const spectral::RelightMatrix& matrix,
                                     const DisplayEncoder8& encoder, std::uint8_t* rgb_out);
 
-// XYZ → 8-bit display RGB, the values write_output_image writes into an 8-bit PNG (OCIO transform,
+// XYZ → 8-bit display RGB, the values spectral::write_output_image writes into an 8-bit PNG (OCIO transform,
 // clamp to [0, 1], round to 255ths), computed fast when the transform is a matrix followed by a
 // per-channel curve (DisplayTransform::split_matrix_curve): the curve is baked into the 255 exact
 // linear thresholds between codes per channel, found by bisection on the curve itself, with a

@@ -10,20 +10,33 @@
 
 #include "prizma/relight/compressed_relight.h"
 #include "prizma/relight/light_spec.h"
-#include "prizma/relight/output_image.h"
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
-#include "prizma/relight/xyz_image.h"
+#include "prizma/spectral/output_image.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
+#include "prizma/spectral/xyz_image.h"
+#include "prizma/spectral/default_lights.h"
 #include "prizma/spectral/display.h"
 #include "prizma/spectral/spectral_exr.h"
 
 namespace prizma::relight {
 
+// How a front end names the settings in its errors: as the user gave them ("--exposure" on the
+// command line, "batch.json: outputs[0].exposure" in a batch file, "state: exposure" from the page).
+struct RelightSettingNames {
+  std::string exposure = "exposure";
+  std::string bit_depth = "bit depth";
+};
+
 // Everything that decides an output image besides the transport.
 struct RelightSettings {
   std::vector<LightSpec> lights;  // one per layer, in the image's layer order
-  RelightOptions relight;
-  OutputOptions output;
+  spectral::RelightOptions relight;
+  spectral::OutputOptions output;
+
+  // The limits every front end shares, checked here only: the exposure (finite, within ±64 stops,
+  // RelightOptions::validate) and the bit depth (8 or 16, OutputOptions::validate). Throws
+  // InputError naming the value as `names` says.
+  void validate(const RelightSettingNames& names = {}) const;
 };
 
 // What `probe X Y` reports about one pixel.
@@ -62,19 +75,19 @@ class RelightSession {
   const CompressedTransport* coefficients() const { return m_compressed.get(); }
   const std::string& source() const { return m_source; }
   // Layer names as users type them ("T" for an unnamed single layer).
-  const std::vector<std::string>& light_names() const { return m_light_names; }
+  const std::vector<std::string>& light_names() const { return m_defaults.names; }
   // The layer's index; throws InputError (input `input`) listing the file's lights when unknown.
   int light_index(std::string_view name, const std::string& input = "--light") const;
   // Per layer, the default light (file's prizma:lights spectrum, else D65). A recorded spectrum that
   // cannot be parsed here (a CSV left on the rendering machine) does not stop the file from opening:
   // its default is an "off" placeholder with the recorded text, and relight() throws InputError
   // naming the light until the user gives that light a spectrum.
-  const std::vector<LightSpec>& default_lights() const { return m_default_lights; }
+  const std::vector<LightSpec>& default_lights() const { return m_defaults.lights; }
 
   const RelightSettings& settings() const { return m_settings; }
-  // Replaces every setting at once; validates (builds the matrix and display) before committing,
-  // so a failure leaves the session as it was.
-  void apply(RelightSettings settings);
+  // Replaces every setting at once; validates (RelightSettings::validate with `names`, then builds the
+  // matrix and display) before committing, so a failure leaves the session as it was.
+  void apply(RelightSettings settings, const RelightSettingNames& names = {});
   // Sets `given` on every layer of `lights` (settings().lights, or settings being built from them),
   // as every all-lights form means it (--light SPEC, a batch file's "lights": "SPEC", the shell's
   // `light SPEC`, prizma.relight(lights=SPEC)): a spec that says its scale as it is, a bare one at
@@ -90,8 +103,8 @@ class RelightSession {
   // Relights with the current settings when anything changed; returns the time it took in ms
   // (0 when nothing changed).
   double relight();
-  const XyzImage& xyz();
-  const RelightMatrix& matrix() const { return m_matrix; }
+  const spectral::XyzImage& xyz();
+  const spectral::RelightMatrix& matrix() const { return m_matrix; }
   // The display transform for the current settings (built on first use after a change; throws
   // InputError when the config or display does not exist).
   const spectral::DisplayTransform& display();
@@ -104,7 +117,7 @@ class RelightSession {
   void save(const std::filesystem::path& path, const std::string& input = "--output",
             spectral::OutputGroup* group = nullptr);
   // Attributes describing how the image was made.
-  ImageMetadata metadata() const;
+  spectral::ImageMetadata metadata() const;
   // One line per layer: "name: spec".
   std::string describe_lights() const;
 
@@ -114,15 +127,13 @@ class RelightSession {
 
   spectral::SpectralImage m_image;
   std::string m_source;
-  std::vector<std::string> m_light_names;
-  std::vector<LightSpec> m_default_lights;
-  std::vector<std::string> m_default_errors;
+  spectral::DefaultLights m_defaults;  // names, default lights and why any cannot be used (default_lights.h)
   RelightSettings m_settings;
-  RelightMatrix m_matrix;
+  spectral::RelightMatrix m_matrix;
   std::unique_ptr<spectral::DisplayTransform> m_display;
   spectral::DisplayOptions m_display_options;
-  XyzImage m_xyz;
-  ReradiationWeights m_reradiation;  // bispectral images: K per observer (relight_image.h)
+  spectral::XyzImage m_xyz;
+  spectral::ReradiationWeights m_reradiation;  // bispectral images: K per observer (relight_image.h)
   std::unique_ptr<CompressedTransport> m_compressed;
   bool m_dirty = true;
 };

@@ -33,28 +33,28 @@ std::string event_probabilities_name(EventProbabilities e);
 // The inverse; InputError(input, "must be one of ...") for any other name.
 EventProbabilities parse_event_probabilities(std::string_view name, std::string_view input = "event_probabilities");
 
-// What the auto rule measured in each material's spectra (bin averages) and what it chose.
+// What the two auto rules measure in a material's spectra (bin averages), and the event scheme
+// chosen. Only what a rule decides by is measured: albedo_max decides the event scheme (below),
+// extinction_ratio the wavelength sampling (resolve_wavelength_sampling, render.h). Both rules are
+// written out once, in docs/renderer.md ("Event probabilities", "Which scenes take spectral MIS").
 struct MaterialEvents {
   EventProbabilities scheme = EventProbabilities::Max;
-  double extinction_ratio = 1.0;  // max_i σt,i / min_i σt,i over the bins (1 = grey; ∞ when some σt,i = 0)
-  double albedo_spread = 0.0;     // max_i α_i − min_i α_i over the bins (α = σs/σt)
-  double albedo_max = 0.0;        // max_i α_i
+  double albedo_max = 0.0;        // max_i α_i over the bins (α = σs/σt); 0 when the material has no extinction
+  double extinction_ratio = 1.0;  // max_i σt,i / min_i σt,i over the bins (1 = grey or no extinction; ∞ when some σt,i = 0)
 };
 
-// The auto rule (docs/renderer.md, "Event probabilities"), per material, since the scheme may change
-// from one collision to the next without bias: "implicit", except in a material that absorbs more
-// than it scatters in every bin (max_i α_i < kAbsorbingAlbedo), where implicit capture would walk
-// the path through the whole absorber: "max" there (average had 0.86× max's variance on the
-// metamer pair, docs/results.md). Deterministic: a function of the material's
-// spectra and the bins only. `requested` other than Auto is given to every material as it is (the
-// measurements still made).
+// The event-probability auto rule (docs/renderer.md, "Event probabilities"), per material:
+// "implicit", or "max" where max_i α_i < kAbsorbingAlbedo. Deterministic: a function of the
+// material's spectra and the bins only. `requested` other than Auto is given to every material as
+// it is (the measurements still made: the wavelength-sampling rule reads extinction_ratio).
 inline constexpr double kAbsorbingAlbedo = 0.5;
 MaterialEvents choose_event_probabilities(EventProbabilities requested, const Material& material,
                                           const spectral::BinLayout& bins);
 std::vector<MaterialEvents> choose_event_probabilities(EventProbabilities requested,
                                                        const std::vector<Material>& materials,
                                                        const spectral::BinLayout& bins);
-// "rayleigh average (extinction ratio 9.4, albedo spread 0), sphere max (1, 0.55)": for logs.
+// "rayleigh implicit (albedo max 0.99, extinction ratio 7.7), absorber max (albedo max 0.4,
+// extinction ratio 1)": for logs (prizma-render -v), each material's scheme and both measures.
 std::string describe_event_probabilities(const std::vector<MaterialEvents>& choice,
                                          const std::vector<Material>& materials);
 

@@ -6,10 +6,11 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace prizma::render {
 
-constexpr double kInv4Pi = 0.07957747154594767;
+constexpr double kInv4Pi = 1.0 / (4.0 * std::numbers::pi);
 
 // p_HG(cos θ; g) = (1 − g²) / (4π (1 + g² − 2g cos θ)^{3/2}), per steradian.
 inline float hg_phase(float cos_theta, float g) {
@@ -39,7 +40,7 @@ inline Eigen::Vector3d direction_around(const Eigen::Vector3d& w, double cos_the
   Eigen::Vector3d a, b;
   orthonormal_basis(w, a, b);
   const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
-  const double phi = 2.0 * 3.14159265358979323846 * u_phi;
+  const double phi = 2.0 * std::numbers::pi * u_phi;
   return (sin_theta * std::cos(phi)) * a + (sin_theta * std::sin(phi)) * b + cos_theta * w;
 }
 

@@ -2,7 +2,7 @@
 // render(): the spectral volume path tracer, from a validated Scene to a SpectralImage holding, per
 // pixel, per light and per bin, the bin-averaged radiance under that light at unit white spectrum
 // (docs/renderer.md). merge_shards() combines renders of disjoint sample ranges; write_preview()
-// relights a transport image with each light's default spectrum into an 8-bit sRGB PNG.
+// writes a render's default relight, exactly as prizma-relight writes it.
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -79,31 +79,29 @@ std::vector<spectral::LightRecord> light_records(const std::vector<Light>& light
 std::vector<Light> lights_from_image(const spectral::SpectralImage& image);
 
 struct PreviewOptions {
-  double exposure_ev = 0.0;  // linear scale 2^exposure_ev before encoding
-  std::filesystem::path spectrum_base_dir;  // csv: spectra resolve against this folder
+  std::string source;  // the spectral EXR the preview is of (prizma:source, messages)
+  bool half = false;   // that file holds half floats: the preview relights the values rounded to half
   // The run's group of outputs the preview joins (spectral/output_group.h); null: written at once.
   spectral::OutputGroup* group = nullptr;
 };
 
-// Relights every light with its default spectrum (in units where D65 at scale 1 makes a perfect
-// white Y = 1, so "D65*0.2" is a fifth as bright; summed over lights), converts
-// XYZ → linear sRGB → sRGB-encoded 8-bit and writes a PNG (or any OpenImageIO format by extension)
-// atomically. Throws InputError for an unknown spectrum spec, RuntimeError for I/O failures.
+// The default relight of `image` (spectral/default_lights.h: every light under the spectrum its
+// record gives, through the one relight and OpenColorIO's default display), written exactly as
+// `prizma-relight SOURCE -o PATH` writes it: the same pixels, format by extension (.png, .tif, .jpg,
+// .exr; spectral::write_output_image, which check_output_path checks before a render), atomically or
+// into opts.group. Throws InputError for a light whose recorded spectrum cannot be used here (a csv:
+// file missing on this machine), RuntimeError for I/O failures.
 void write_preview(const std::filesystem::path& path, const spectral::SpectralImage& image,
-                   const std::vector<Light>& lights, const PreviewOptions& opts = {});
-// Checks before rendering that a preview can be written at `path` (spectral::check_output_file and a
-// format OpenImageIO writes); throws InputError(input, …).
-void check_preview_path(const std::filesystem::path& path, const std::string& input);
+                   const PreviewOptions& opts = {});
 
 // "auto" / "spectral-tracking" / "spectral-mis" / "single", as taken by the CLI and the scene file;
 // prizma:wavelengthSampling stores the resolved one (never "auto").
 std::string wavelength_sampling_name(WavelengthSampling w);
 WavelengthSampling parse_wavelength_sampling(std::string_view name, std::string_view input = "wavelength sampling");
-// The estimator a render of `scene` runs (docs/renderer.md, "Which scenes take spectral MIS"): the
-// setting, or for Auto spectral MIS where some material's extinction ratio across the bins (largest
-// over least bin average) exceeds kMisExtinctionRatio and no material fluoresces, else spectral
-// tracking. Throws InputError("wavelength_sampling", …) for spectral-mis with a fluorescent material,
-// which it does not support.
+// The estimator a render of `scene` runs: the setting, or for Auto the wavelength-sampling auto rule
+// (docs/renderer.md, "Which scenes take spectral MIS": spectral MIS where some material's
+// MaterialEvents::extinction_ratio exceeds kMisExtinctionRatio and none fluoresces). Throws
+// InputError("wavelength_sampling", …) for spectral-mis with a fluorescent material.
 inline constexpr double kMisExtinctionRatio = 1.1;
 WavelengthSampling resolve_wavelength_sampling(const Scene& scene);
 

@@ -27,7 +27,7 @@ struct InspectedVolume {
 // Reads a scene file (.json: its volume, normalisation and materials or transfer-function image, as
 // load_scene reads them, without building the medium) or a volume file (.nii, .nii.gz, .raw, .vdb
 // with its "density" grid: as a scene's "volume" of that type reads it). InputError as those do; an
-// unknown extension names the ones known. Defined in scene_loader.cpp, whose reader it uses.
+// unknown extension names the ones known. Defined in scene/scene_loader.cpp, with the scene reader's sections.
 InspectedVolume load_for_inspection(const std::filesystem::path& path);
 
 struct VolumeStatistics {

@@ -12,17 +12,17 @@
 #include <string>
 #include <vector>
 
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 #include "prizma/spectral/colour.h"
-#include "prizma/relight/relight_matrix.h"
-#include "relight_test_util.h"
+#include "prizma/spectral/relight_matrix.h"
+#include "spectral/relight_test_util.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 namespace {
 
-std::vector<LightSpec> lights(const std::vector<std::string>& specs) {
-  std::vector<LightSpec> out;
-  for (const auto& s : specs) out.push_back(parse_light_spec(s));
+std::vector<LightSpectrum> lights(const std::vector<std::string>& specs) {
+  std::vector<LightSpectrum> out;
+  for (const auto& s : specs) out.push_back(parse_light_spectrum(s));
   return out;
 }
 
@@ -140,4 +140,4 @@ TEST(BispectralRelight, PreviewChannelsIncludeTheReradiation) {
 }
 
 }  // namespace
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

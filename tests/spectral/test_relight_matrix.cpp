@@ -5,13 +5,13 @@
 
 #include <cmath>
 
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/colour.h"
-#include "relight/relight_test_util.h"
+#include "spectral/relight_test_util.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 namespace {
 
 using spectral::BinLayout;
@@ -21,9 +21,9 @@ float transport(int layer, int pixel, int bin) {
   return static_cast<float>(0.05 + 0.9 * std::fmod(0.137 * (bin + 1) + 0.291 * pixel + 0.5 * layer, 1.0));
 }
 
-std::vector<LightSpec> lights(std::initializer_list<const char*> specs) {
-  std::vector<LightSpec> out;
-  for (const char* s : specs) out.push_back(parse_light_spec(s));
+std::vector<LightSpectrum> lights(std::initializer_list<const char*> specs) {
+  std::vector<LightSpectrum> out;
+  for (const char* s : specs) out.push_back(parse_light_spectrum(s));
   return out;
 }
 
@@ -158,31 +158,31 @@ TEST(RelightMatrix, ResultDoesNotDependOnThreadCount) {
   EXPECT_EQ(a.xyz, b.xyz);
 }
 
-TEST(LightSpec, ParsesScalesAndOff) {
-  const LightSpec a = parse_light_spec("D65*0.5*4");
+TEST(LightSpectrum, ParsesScalesAndOff) {
+  const LightSpectrum a = parse_light_spectrum("D65*0.5*4");
   EXPECT_DOUBLE_EQ(a.scale, 2.0);
   EXPECT_FALSE(a.off);
-  EXPECT_TRUE(parse_light_spec("off").off);
-  EXPECT_TRUE(parse_light_spec("D65*0").off);
-  EXPECT_THROW(parse_light_spec("D66"), spectral::InputError);
-  EXPECT_THROW(parse_light_spec("D65*-1"), spectral::InputError);
-  EXPECT_THROW(parse_light_spec(""), spectral::InputError);
+  EXPECT_TRUE(parse_light_spectrum("off").off);
+  EXPECT_TRUE(parse_light_spectrum("D65*0").off);
+  EXPECT_THROW(parse_light_spectrum("D66"), spectral::InputError);
+  EXPECT_THROW(parse_light_spectrum("D65*-1"), spectral::InputError);
+  EXPECT_THROW(parse_light_spectrum(""), spectral::InputError);
 }
 
 // issue 21: "D65*1e39" gave +inf weights, NaN pixels and a black image with exit 0. A light's scale is
 // at most kMaxLightScale (the product of its factors); just inside, at the largest exposure, every
 // weight and every relit value is finite and the image is not black.
-TEST(LightSpec, ScaleAboveTheBoundIsRefused) {
+TEST(LightSpectrum, ScaleAboveTheBoundIsRefused) {
   for (const char* spec : {"D65*1e39", "D65*1e13", "D65*1e7*1e6", "A*1e300*1e300"}) {
     try {
-      parse_light_spec(spec, {"--light key", {}});
+      parse_light_spectrum(spec, {"--light key", {}});
       ADD_FAILURE() << spec;
     } catch (const spectral::InputError& e) {
       EXPECT_EQ(e.input(), "--light key");
       EXPECT_NE(e.reason().find("is above 1e+12"), std::string::npos) << e.what();
     }
   }
-  EXPECT_DOUBLE_EQ(parse_light_spec("D65*1e6*1e6").scale, spectral::kMaxLightScale);
+  EXPECT_DOUBLE_EQ(parse_light_spectrum("D65*1e6*1e6").scale, spectral::kMaxLightScale);
   const BinLayout bins = BinLayout::linear(400.0, 700.0, 16);
   const auto img = test::make_image(3, 3, bins, {"key"}, transport);
   RelightOptions brightest;
@@ -214,4 +214,4 @@ TEST(RelightMatrix, RefusesWeightsAFloatCannotHold) {
 }
 
 }  // namespace
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

@@ -4,14 +4,12 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "prizma/render/scene.h"
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/cli_support.h"
 #include "prizma/spectral/colour.h"
@@ -101,62 +99,18 @@ ps::Spectrum parse_option(const std::string& spec, const std::string& option) {
   return ps::parse_spectrum(spec, ps::SpecContext{option, {}});
 }
 
-// The albedo of a material of a scene file: `materials` as an array of objects with "name" (or
-// looked up by index) or as an object keyed by name; "albedo" a spec string or a number.
-ps::Spectrum scene_albedo(const std::filesystem::path& scene_path, const std::string& material) {
-  ps::require_regular_file(scene_path, "a scene file");
-  std::ifstream in(scene_path, std::ios::binary);
-  if (!in) throw ps::InputError(scene_path.string(), "cannot open the scene file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  ps::check_json_depth(text, scene_path.string());
-  nlohmann::json scene;
-  try {
-    scene = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw ps::InputError(scene_path.string(), std::string("not valid JSON: ") + e.what());
-  }
-  const auto materials = scene.find("materials");
-  if (materials == scene.end()) throw ps::InputError(scene_path.string(), "no \"materials\"");
-  const nlohmann::json* found = nullptr;
-  std::string where;
-  if (materials->is_object()) {
-    const auto it = materials->find(material);
-    if (it != materials->end()) {
-      found = &*it;
-      where = "materials." + material;
-    }
-  } else if (materials->is_array()) {
-    for (size_t i = 0; i < materials->size(); ++i) {
-      const nlohmann::json& m = (*materials)[i];
-      if ((m.is_object() && m.value("name", std::string()) == material) || std::to_string(i) == material) {
-        found = &m;
-        where = "materials[" + std::to_string(i) + "]";
-        break;
-      }
-    }
-  }
-  if (!found) throw ps::InputError(scene_path.string(), "no material \"" + material + "\"");
-  const auto albedo = found->find("albedo");
-  const std::string input = scene_path.string() + ": " + where + ".albedo";
-  if (albedo == found->end()) throw ps::InputError(input, "missing");
-  // A spec string, a number, or {"spectrum": SPEC, "scale": number} (docs/scene-format.md).
-  const auto parse = [&](const nlohmann::json& j, const std::string& where_in) -> ps::Spectrum {
-    if (j.is_number()) return ps::Spectrum::constant(j.get<double>());
-    if (!j.is_string()) throw ps::InputError(where_in, "expected a spectrum spec string or a number");
-    return ps::parse_spectrum(j.get<std::string>(), ps::SpecContext{where_in, scene_path.parent_path()});
-  };
-  if (albedo->is_object()) {
-    const auto inner = albedo->find("spectrum");
-    if (inner == albedo->end()) throw ps::InputError(input + ".spectrum", "missing");
-    ps::Spectrum s = parse(*inner, input + ".spectrum");
-    const auto scale = albedo->find("scale");
-    if (scale != albedo->end()) {
-      if (!scale->is_number()) throw ps::InputError(input + ".scale", "expected a number");
-      s = s.scaled(scale->get<double>());
-    }
-    return s;
-  }
-  return parse(*albedo, input);
+// The albedo of a material of a scene file, read by the renderer's own scene reader (load_scene:
+// every field checked as prizma-render checks it, csv: spectra and the volume's file included); the
+// material named `material`, or the one at that index.
+ps::Spectrum scene_albedo(const prizma::render::Scene& scene, const std::filesystem::path& scene_path,
+                          const std::string& material) {
+  const auto& materials = scene.medium.materials;
+  for (std::size_t i = 0; i < materials.size(); ++i)
+    if (materials[i].name == material || std::to_string(i) == material) return materials[i].albedo;
+  std::string known;
+  for (const auto& m : materials) known += (known.empty() ? "" : ", ") + m.name;
+  throw ps::InputError(scene_path.string(), "no material \"" + material + "\"" +
+                                                (known.empty() ? std::string(" (it has none)") : " (its materials: " + known + ")"));
 }
 
 void print_table(const std::vector<ps::NamedLight>& lights, const std::vector<double>& values,
@@ -196,6 +150,7 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
   options.colour = colour_setting(common);
   options.basis_size = cmd.basis;
   options.max_power_ratio = cmd.max_power_ratio;
+  std::optional<prizma::render::Scene> scene;
   const auto albedo = [&](const std::string& spec, const std::string& material, const std::string& letter) {
     const std::string spec_option = "--albedo-" + letter;
     const std::string material_option = "--material-" + letter;
@@ -203,7 +158,8 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
       throw ps::InputError(spec_option, "give either " + spec_option + " or " + material_option + ", not both");
     if (!material.empty()) {
       if (cmd.scene.empty()) throw ps::InputError(material_option, "needs --scene");
-      return scene_albedo(cmd.scene, material);
+      if (!scene) scene = prizma::render::load_scene(cmd.scene);  // read once for both materials
+      return scene_albedo(*scene, cmd.scene, material);
     }
     if (spec.empty()) throw ps::InputError(spec_option, "missing (or give --scene and " + material_option + ")");
     return parse_option(spec, spec_option);

@@ -9,12 +9,12 @@
 #include <functional>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "prizma/spectral/spectral_exr.h"
+#include "spectral/scratch_files.h"
 
-namespace prizma::relight::test {
+namespace prizma::spectral::test {
 
 // A table read from data/spectra/<file>: first column nm, other columns values.
 struct Table {
@@ -99,13 +99,7 @@ inline spectral::SpectralImage fluorescent_image() {
   return img;
 }
 
-// A fresh scratch folder per test.
-inline std::filesystem::path scratch_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("prizma-relight-test-" + std::to_string(::getpid()) + "-" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+// A fresh scratch folder per test (scratch_files.h).
+inline std::filesystem::path scratch_dir(const std::string& name) { return scratch_dir("relight", name); }
 
-}  // namespace prizma::relight::test
+}  // namespace prizma::spectral::test

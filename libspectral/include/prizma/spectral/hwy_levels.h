@@ -1,5 +1,5 @@
 #pragma once
-// Highway kernels chosen per kernel (spectral::choose_simd_level) instead of through
+// Highway kernels chosen per kernel (choose_simd_level) instead of through
 // HWY_DYNAMIC_DISPATCH, whose one target is global to the process (libhwy.so's, shared with any
 // other library using Highway) and always the widest the CPU has. Include in the HWY_ONCE part of a
 // file that compiles its kernels with foreach_target.h; `table` is HWY_DISPATCH_TABLE(Function)
@@ -12,19 +12,19 @@
 
 #include "prizma/spectral/simd_choice.h"
 
-namespace prizma::relight::detail {
+namespace prizma::spectral::detail {
 
 #if HWY_ARCH_X86 && (HWY_TARGETS & (HWY_TARGETS - 1)) != 0
 // The Highway target compiled for a level; Baseline is the table's portable fallback.
-inline std::int64_t hwy_target_of(spectral::SimdLevel level) {
+inline std::int64_t hwy_target_of(SimdLevel level) {
   switch (level) {
-    case spectral::SimdLevel::Sse4:
+    case SimdLevel::Sse4:
       return HWY_SSE4;
-    case spectral::SimdLevel::Avx2:
+    case SimdLevel::Avx2:
       return HWY_AVX2;
-    case spectral::SimdLevel::Avx512:
+    case SimdLevel::Avx512:
       return HWY_AVX3;
-    case spectral::SimdLevel::Baseline:
+    case SimdLevel::Baseline:
       break;
   }
   return (HWY_TARGETS & HWY_EMU128) != 0 ? HWY_EMU128 : HWY_SCALAR;
@@ -32,9 +32,9 @@ inline std::int64_t hwy_target_of(spectral::SimdLevel level) {
 
 // Levels whose target is compiled into `table` and runs on this CPU, lowest first.
 template <class Fn>
-std::vector<spectral::SimdLevel> hwy_levels(const Fn* table) {
-  std::vector<spectral::SimdLevel> levels{spectral::SimdLevel::Baseline};
-  for (spectral::SimdLevel l : {spectral::SimdLevel::Sse4, spectral::SimdLevel::Avx2, spectral::SimdLevel::Avx512}) {
+std::vector<SimdLevel> hwy_levels(const Fn* table) {
+  std::vector<SimdLevel> levels{SimdLevel::Baseline};
+  for (SimdLevel l : {SimdLevel::Sse4, SimdLevel::Avx2, SimdLevel::Avx512}) {
     const std::int64_t target = hwy_target_of(l);
     if ((target & HWY_TARGETS & hwy::SupportedTargets()) == 0) continue;
     // The table's slot for a target (highway.h, HWY_EXPORT; targets.h, ChosenTarget::GetIndex).
@@ -46,25 +46,25 @@ std::vector<spectral::SimdLevel> hwy_levels(const Fn* table) {
 
 // The function compiled for `level` (one of hwy_levels(table)).
 template <class Fn>
-Fn hwy_function(const Fn* table, spectral::SimdLevel level) {
-  if (level == spectral::SimdLevel::Baseline) return table[HWY_MAX_DYNAMIC_TARGETS + 1];
+Fn hwy_function(const Fn* table, SimdLevel level) {
+  if (level == SimdLevel::Baseline) return table[HWY_MAX_DYNAMIC_TARGETS + 1];
   return table[hwy::Num0BitsBelowLS1Bit_Nonzero64(static_cast<std::uint64_t>(HWY_CHOSEN_TARGET_SHIFT(hwy_target_of(level))))];
 }
 #else
 // One target compiled (a build for one instruction set), or not x86: one level, "baseline", which
 // is the table's first slot: the static target, or Highway's own run-time choice.
-inline std::int64_t hwy_target_of(spectral::SimdLevel) { return HWY_STATIC_TARGET; }
+inline std::int64_t hwy_target_of(SimdLevel) { return HWY_STATIC_TARGET; }
 template <class Fn>
-std::vector<spectral::SimdLevel> hwy_levels(const Fn*) {
-  return {spectral::SimdLevel::Baseline};
+std::vector<SimdLevel> hwy_levels(const Fn*) {
+  return {SimdLevel::Baseline};
 }
 template <class Fn>
-Fn hwy_function(const Fn* table, spectral::SimdLevel) {
+Fn hwy_function(const Fn* table, SimdLevel) {
   return table[0];
 }
 #endif
 
 // "AVX3", "AVX2", "SSE4", "EMU128", …: Highway's name of the target behind a level.
-inline std::string hwy_target_name(spectral::SimdLevel level) { return hwy::TargetName(hwy_target_of(level)); }
+inline std::string hwy_target_name(SimdLevel level) { return hwy::TargetName(hwy_target_of(level)); }
 
-}  // namespace prizma::relight::detail
+}  // namespace prizma::spectral::detail

@@ -1,4 +1,4 @@
-#include "prizma/relight/relight_matrix.h"
+#include "prizma/spectral/relight_matrix.h"
 
 #include <cmath>
 #include <iomanip>
@@ -7,31 +7,36 @@
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 
-RelightMatrix::RelightMatrix(const spectral::BinLayout& bins, const std::vector<LightSpec>& lights,
+void RelightOptions::validate(const std::string& exposure_input) const {
+  if (!std::isfinite(exposure_ev) || std::abs(exposure_ev) > kMaxExposureEv)
+    throw InputError(exposure_input, "must be a finite number of stops within ±64");
+}
+
+RelightMatrix::RelightMatrix(const BinLayout& bins, const std::vector<LightSpectrum>& lights,
                              const RelightOptions& opts)
     : m_bins(bins.size()), m_options(opts) {
-  const spectral::ColorMatching& cmf = spectral::ColorMatching::get(opts.cmf);
+  const ColorMatching& cmf = ColorMatching::get(opts.cmf);
   // Per light: exact ∫_{bin} E·cmf dλ (normalised unless absolute), times the light's scale.
   m_per_light.reserve(lights.size());
-  for (const LightSpec& light : lights) {
-    m_per_light.push_back(spectral::relight_weights(cmf, light, bins, opts.units));
+  for (const LightSpectrum& light : lights) {
+    m_per_light.push_back(relight_weights(cmf, light, bins, opts.units));
     m_mix_white += m_per_light.back().rowwise().sum();
   }
   // Bradford from the mix's white (at its own luminance) to D65 at the same luminance.
   if (opts.adapt_to_d65 && m_mix_white.y() > 0.0) {
-    m_adaptation = spectral::bradford_adaptation(m_mix_white / m_mix_white.y(), spectral::white_d65());
+    m_adaptation = bradford_adaptation(m_mix_white / m_mix_white.y(), white_d65());
   }
   const double exposure = std::exp2(opts.exposure_ev);
   m_output = exposure * m_adaptation;
   // Bin averages of each light for bispectral terms, normalised as relight_weights normalises.
-  for (const LightSpec& light : lights) {
+  for (const LightSpectrum& light : lights) {
     Eigen::VectorXd e = Eigen::VectorXd::Zero(m_bins);
     if (!light.off && light.scale != 0.0) {
       double norm = 1.0;
-      if (opts.units == spectral::LightUnits::RelativeToWhite)
-        norm = 1.0 / spectral::relight_weights(cmf, light.spectrum, bins, spectral::LightUnits::Absolute).row(1).sum();
+      if (opts.units == LightUnits::RelativeToWhite)
+        norm = 1.0 / relight_weights(cmf, light.spectrum, bins, LightUnits::Absolute).row(1).sum();
       for (int i = 0; i < m_bins; ++i)
         e[i] = light.scale * norm * light.spectrum.integrate(bins.lo_nm(i), bins.hi_nm(i)) / bins.width_nm(i);
     }
@@ -46,18 +51,18 @@ RelightMatrix::RelightMatrix(const spectral::BinLayout& bins, const std::vector<
     if (!m_stacked.middleCols(static_cast<Eigen::Index>(l) * m_bins, m_bins).allFinite()) {
       std::ostringstream largest;
       largest << std::setprecision(3) << m_per_light[l].cwiseAbs().maxCoeff();
-      throw spectral::InputError("light", "\"" + lights[l].text + "\": its relight weights (up to " + largest.str() +
+      throw InputError("light", "\"" + lights[l].text + "\": its relight weights (up to " + largest.str() +
                                               ") overflow a float; give a smaller scale or exposure");
     }
   }
 }
 
-Matrix3Xd bin_cmf_integrals(spectral::Observer observer, const spectral::BinLayout& bins) {
-  const spectral::ColorMatching& cmf = spectral::ColorMatching::get(observer);
+Matrix3Xd bin_cmf_integrals(Observer observer, const BinLayout& bins) {
+  const ColorMatching& cmf = ColorMatching::get(observer);
   Matrix3Xd m(3, bins.size());
   for (int i = 0; i < bins.size(); ++i)
     for (int c = 0; c < 3; ++c) m(c, i) = cmf.channel(c).integrate(bins.lo_nm(i), bins.hi_nm(i));
   return m;
 }
 
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "prizma/relight/output_image.h"
-#include "relight/relight_test_util.h"
+#include "prizma/spectral/output_image.h"
+#include "spectral/relight_test_util.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 namespace {
 
 namespace fs = std::filesystem;
@@ -180,4 +180,4 @@ TEST(OutputIcc, DisplayColourSpaceOfTheShippedDisplays) {
 }
 
 }  // namespace
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

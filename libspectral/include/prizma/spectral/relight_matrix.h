@@ -2,22 +2,31 @@
 // RelightMatrix: per light layer the 3×n matrix taking the layer's transport bins to CIE XYZ, with
 // exposure and optional chromatic adaptation folded in, and all layers stacked side by side.
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
-#include "prizma/relight/light_spec.h"
+#include "prizma/spectral/light_spectrum.h"
 #include "prizma/spectral/bin_layout.h"
 #include "prizma/spectral/colour_matching.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
+
+// The exposure every tool accepts, in stops either way: 2^64 ≈ 1.8e19, which the float weights hold
+// for any light up to kMaxLightScale (light_spectrum.h).
+constexpr double kMaxExposureEv = 64.0;
 
 struct RelightOptions {
-  spectral::Observer cmf = spectral::Observer::Cie1931_2deg;
+  Observer cmf = Observer::Cie1931_2deg;
   // RelativeToWhite: a perfect white (T = 1) under each light at scale 1 has Y = 1.
-  spectral::LightUnits units = spectral::LightUnits::RelativeToWhite;
-  double exposure_ev = 0.0;  // output multiplied by 2^exposure_ev
+  LightUnits units = LightUnits::RelativeToWhite;
+  double exposure_ev = 0.0;  // output multiplied by 2^exposure_ev; finite, within ±kMaxExposureEv
   // Bradford adaptation from the white of the light mix (XYZ of T = 1 under all lights) to D65,
   // preserving the white's luminance. Ignored when every light is off.
   bool adapt_to_d65 = false;
+
+  // Throws InputError(exposure_input, "must be a finite number of stops within ±64") for an exposure
+  // out of range; `exposure_input` names it as the user gave it ("--exposure", "state: exposure").
+  void validate(const std::string& exposure_input = "exposure") const;
 };
 
 using Matrix3Xd = Eigen::Matrix<double, 3, Eigen::Dynamic>;
@@ -26,10 +35,10 @@ using Matrix3Xf = Eigen::Matrix<float, 3, Eigen::Dynamic>;
 class RelightMatrix {
  public:
   RelightMatrix() = default;
-  // One LightSpec per transport layer, in the image's layer order. The weights are exact integrals
-  // of light × CMF over each bin (spectral::relight_weights); "off" layers get a zero matrix.
+  // One LightSpectrum per transport layer, in the image's layer order. The weights are exact integrals
+  // of light × CMF over each bin (relight_weights); "off" layers get a zero matrix.
   // Throws InputError (from relight_weights) when a light has no energy in the bins.
-  RelightMatrix(const spectral::BinLayout& bins, const std::vector<LightSpec>& lights,
+  RelightMatrix(const BinLayout& bins, const std::vector<LightSpectrum>& lights,
                 const RelightOptions& opts);
 
   int light_count() const { return static_cast<int>(m_per_light.size()); }
@@ -64,6 +73,6 @@ class RelightMatrix {
 };
 
 // ∫_{bin} cmf_c dλ for every bin (3×n): the XYZ of a radiance constant inside each bin.
-Matrix3Xd bin_cmf_integrals(spectral::Observer observer, const spectral::BinLayout& bins);
+Matrix3Xd bin_cmf_integrals(Observer observer, const BinLayout& bins);
 
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

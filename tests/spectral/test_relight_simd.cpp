@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "prizma/relight/relight_image.h"
-#include "prizma/relight/relight_matrix.h"
-#include "prizma/relight/relight_simd.h"
+#include "prizma/spectral/relight_image.h"
+#include "prizma/spectral/relight_matrix.h"
+#include "prizma/spectral/relight_simd.h"
 #include "prizma/spectral/spectral_exr.h"
 
 namespace {
@@ -57,7 +57,7 @@ struct ForcedLevel : spectral::ForcedSimdLevel {
 }
 
 TEST(RelightSimd, EveryLevelMatchesTheScalarSumWithTheSameBits) {
-  const std::vector<SimdLevel> targets = relight::detail::relight_simd_levels();
+  const std::vector<SimdLevel> targets = spectral::detail::relight_simd_levels();
   ASSERT_FALSE(targets.empty());
   EXPECT_EQ(targets.front(), SimdLevel::Baseline);
 #if defined(__x86_64__)
@@ -66,9 +66,9 @@ TEST(RelightSimd, EveryLevelMatchesTheScalarSumWithTheSameBits) {
   // Bin counts that fill whole vectors of every width and ones that leave a tail.
   for (const int bins : {1, 5, 16, 32, 33, 64}) {
     const spectral::SpectralImage img = random_image(19, 7, bins, 2, 100u + static_cast<unsigned>(bins));
-    const std::vector<relight::LightSpec> lights = {relight::parse_light_spec("D65"), relight::parse_light_spec("F11")};
-    const relight::RelightMatrix matrix(img.bins, lights, {});
-    // Reference: the float weights relight_into uses, summed in double.
+    const std::vector<spectral::LightSpectrum> lights = {spectral::parse_light_spectrum("D65"), spectral::parse_light_spectrum("F11")};
+    const spectral::RelightMatrix matrix(img.bins, lights, {});
+    // Reference: the float weights spectral::relight_into uses, summed in double.
     std::vector<double> ref(3 * img.pixel_count(), 0.0), mag(3 * img.pixel_count(), 0.0);
     for (int l = 0; l < 2; ++l)
       for (std::size_t p = 0; p < img.pixel_count(); ++p)
@@ -83,8 +83,8 @@ TEST(RelightSimd, EveryLevelMatchesTheScalarSumWithTheSameBits) {
     std::vector<float> first;
     for (const SimdLevel target : targets) {
       const ForcedLevel forced(target);
-      ASSERT_EQ(relight::detail::relight_simd_level(), target);
-      const relight::XyzImage out = relight::relight_image(img, matrix);
+      ASSERT_EQ(spectral::detail::relight_simd_level(), target);
+      const spectral::XyzImage out = spectral::relight_image(img, matrix);
       ASSERT_EQ(out.xyz.size(), ref.size());
       for (std::size_t k = 0; k < ref.size(); ++k) {
         // Float sums of up to 128 positive terms: a few ulps of the magnitude.
@@ -103,7 +103,7 @@ TEST(RelightSimd, FoldedBispectralTermMatchesADoubleReferenceOnEveryTarget) {
   // A fluorescent image: the re-radiation (K·ē through the 3×3 output matrix) runs in the same row
   // pass as the diagonal (relight_row_terms_simd). Reference: T·M_l + output·Σ_out C·M·ē in double
   // straight from the pairs, never through K. Bin counts and |in| that leave tails on every width.
-  const std::vector<SimdLevel> targets = relight::detail::relight_simd_levels();
+  const std::vector<SimdLevel> targets = spectral::detail::relight_simd_levels();
   for (const int bins : {5, 12, 33}) {
     spectral::SpectralImage img = random_image(13, 5, bins, 2, 300u + static_cast<unsigned>(bins));
     for (int in = 0; in < bins / 2; ++in)
@@ -114,12 +114,12 @@ TEST(RelightSimd, FoldedBispectralTermMatchesADoubleReferenceOnEveryTarget) {
       layer.reradiation.resize(img.pixel_count() * img.reradiation.size());
       for (float& v : layer.reradiation) v = u(rng);
     }
-    relight::RelightOptions opts;
+    spectral::RelightOptions opts;
     opts.exposure_ev = 0.7;
     opts.adapt_to_d65 = true;  // a full 3×3 output matrix
-    const std::vector<relight::LightSpec> lights = {relight::parse_light_spec("LED-V1"), relight::parse_light_spec("A*0.5")};
-    const relight::RelightMatrix matrix(img.bins, lights, opts);
-    const relight::Matrix3Xd c_out = relight::bin_cmf_integrals(opts.cmf, img.bins);
+    const std::vector<spectral::LightSpectrum> lights = {spectral::parse_light_spectrum("LED-V1"), spectral::parse_light_spectrum("A*0.5")};
+    const spectral::RelightMatrix matrix(img.bins, lights, opts);
+    const spectral::Matrix3Xd c_out = spectral::bin_cmf_integrals(opts.cmf, img.bins);
     std::vector<double> ref(3 * img.pixel_count(), 0.0), mag(3 * img.pixel_count(), 0.0);
     const std::size_t np = img.reradiation.size(), nb = static_cast<std::size_t>(bins);
     for (std::size_t l = 0; l < 2; ++l) {
@@ -150,13 +150,13 @@ TEST(RelightSimd, FoldedBispectralTermMatchesADoubleReferenceOnEveryTarget) {
     std::vector<float> first;
     for (const SimdLevel target : targets) {
       const ForcedLevel forced(target);
-      const relight::ReradiationWeights k = relight::reradiation_weights(img, opts.cmf);
+      const spectral::ReradiationWeights k = spectral::reradiation_weights(img, opts.cmf);
       std::vector<float> out(3 * img.pixel_count()), diag(3 * img.pixel_count());
-      relight::relight_into(img, matrix, out.data(), &k);
+      spectral::relight_into(img, matrix, out.data(), &k);
       spectral::SpectralImage plain = img;
       plain.reradiation.clear();
       for (auto& layer : plain.lights) layer.reradiation.clear();
-      relight::relight_into(plain, matrix, diag.data());
+      spectral::relight_into(plain, matrix, diag.data());
       for (std::size_t q = 0; q < ref.size(); ++q) {
         // Float rounding of the weights, of K and of sums of up to ~130 terms: a few ulps of the magnitude.
         ASSERT_NEAR(out[q], ref[q], 1e-5 * mag[q] + 1e-30)
@@ -175,10 +175,10 @@ TEST(RelightSimd, FoldedBispectralTermMatchesADoubleReferenceOnEveryTarget) {
 TEST(RelightSimd, SameTargetSameBits) {
   // One machine, one target: repeated relights are bit-identical (rows are independent of threads).
   const spectral::SpectralImage img = random_image(64, 32, 16, 2, 7u);
-  const std::vector<relight::LightSpec> lights = {relight::parse_light_spec("A"), relight::parse_light_spec("D65")};
-  const relight::RelightMatrix matrix(img.bins, lights, {});
-  const relight::XyzImage a = relight::relight_image(img, matrix);
-  const relight::XyzImage b = relight::relight_image(img, matrix);
+  const std::vector<spectral::LightSpectrum> lights = {spectral::parse_light_spectrum("A"), spectral::parse_light_spectrum("D65")};
+  const spectral::RelightMatrix matrix(img.bins, lights, {});
+  const spectral::XyzImage a = spectral::relight_image(img, matrix);
+  const spectral::XyzImage b = spectral::relight_image(img, matrix);
   EXPECT_EQ(a.xyz, b.xyz);
 }
 
@@ -219,11 +219,11 @@ TEST(RelightSimd, TheLastBlockNeverReadsPastTheRow) {
       for (std::size_t i = 0; i < floats; ++i) row.values()[i] = u(rng);
       std::vector<float> weights(3 * static_cast<std::size_t>(n));
       for (float& w : weights) w = u(rng);
-      const relight::detail::SimdTerm term{weights.data(), row.values(), n};
+      const spectral::detail::SimdTerm term{weights.data(), row.values(), n};
       std::vector<float> first;
-      for (const SimdLevel level : relight::detail::relight_simd_levels()) {
+      for (const SimdLevel level : spectral::detail::relight_simd_levels()) {
         std::vector<float> out(3 * static_cast<std::size_t>(width));
-        relight::detail::relight_row_kernel(level)(&term, 1, 0, width, out.data());
+        spectral::detail::relight_row_kernel(level)(&term, 1, 0, width, out.data());
         for (int x = 0; x < width; ++x)
           for (int c = 0; c < 3; ++c) {
             double ref = 0.0, mag = 0.0;

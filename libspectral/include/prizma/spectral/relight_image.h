@@ -3,26 +3,26 @@
 #include <string>
 #include <vector>
 
-#include "prizma/relight/relight_matrix.h"
-#include "prizma/relight/xyz_image.h"
+#include "prizma/spectral/relight_matrix.h"
+#include "prizma/spectral/xyz_image.h"
 #include "prizma/spectral/spectral_exr.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 
 // Pure function: relights every pixel (TBB, parallel over rows, one pass over the transport, no
 // per-pixel allocation). The result does not depend on the thread count. Throws RuntimeError when
 // the matrix does not match the image's layer or bin count.
-XyzImage relight_image(const spectral::SpectralImage& image, const RelightMatrix& matrix);
+XyzImage relight_image(const SpectralImage& image, const RelightMatrix& matrix);
 
 // The per-pixel weights K[c][in] = Σ_out cmf_c(out)·M[out][in] of every light of a bispectral
-// (fluorescent) image, for one observer (spectral::reradiation_colour_weights); empty per_light for
+// (fluorescent) image, for one observer (reradiation_colour_weights); empty per_light for
 // a diagonal image. Computed once per image and observer: relighting then adds K·ē per pixel.
 struct ReradiationWeights {
-  spectral::Observer cmf = spectral::Observer::Cie1931_2deg;
+  Observer cmf = Observer::Cie1931_2deg;
   std::vector<int> in_bins;
   std::vector<std::vector<float>> per_light;  // [light]: pixels × 3 × in_bins.size()
 };
-ReradiationWeights reradiation_weights(const spectral::SpectralImage& image, spectral::Observer cmf);
+ReradiationWeights reradiation_weights(const SpectralImage& image, Observer cmf);
 
 // The weights that relight_into gives light `light`'s K in its row pass (and the live page its K
 // textures): 3 rows (X, Y, Z) × values_per_pixel = 3·|in bins|, W[c][c'·|in| + j] =
@@ -45,7 +45,7 @@ std::vector<LightWeights> light_weights(const RelightMatrix& matrix, int layers,
 
 // The same into a caller-owned buffer of 3·width·height floats (reused across interactive relights).
 // For a bispectral image, `k` (for the matrix's observer) is used when given, else computed.
-void relight_into(const spectral::SpectralImage& image, const RelightMatrix& matrix, float* xyz_out,
+void relight_into(const SpectralImage& image, const RelightMatrix& matrix, float* xyz_out,
                   const ReradiationWeights* k = nullptr);
 
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

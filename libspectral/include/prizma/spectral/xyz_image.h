@@ -4,7 +4,7 @@
 #include <cstddef>
 #include <vector>
 
-namespace prizma::relight {
+namespace prizma::spectral {
 
 struct XyzImage {
   int width = 0;
@@ -19,4 +19,4 @@ struct XyzImage {
   }
 };
 
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

@@ -1,4 +1,4 @@
-#include "prizma/relight/relight_image.h"
+#include "prizma/spectral/relight_image.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "prizma/spectral/bispectral.h"
-#include "prizma/relight/relight_simd.h"
+#include "prizma/spectral/relight_simd.h"
 #include "prizma/spectral/error.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 
 namespace {
 
@@ -20,14 +20,14 @@ using LayerTerm = detail::SimdTerm;  // weights: 3·n floats row-major; values: 
 
 }  // namespace
 
-ReradiationWeights reradiation_weights(const spectral::SpectralImage& image, spectral::Observer cmf) {
+ReradiationWeights reradiation_weights(const SpectralImage& image, Observer cmf) {
   ReradiationWeights k;
   k.cmf = cmf;
   if (image.reradiation.empty()) return k;
-  k.in_bins = spectral::reradiation_in_bins(image);
+  k.in_bins = reradiation_in_bins(image);
   const Matrix3Xd c_out = bin_cmf_integrals(cmf, image.bins);
   for (int l = 0; l < static_cast<int>(image.lights.size()); ++l)
-    k.per_light.push_back(spectral::reradiation_colour_weights(image, l, c_out, k.in_bins));
+    k.per_light.push_back(reradiation_colour_weights(image, l, c_out, k.in_bins));
   return k;
 }
 
@@ -36,18 +36,18 @@ namespace {
 // The re-radiation as terms of the same row pass: per light that is on, its K (3·|in| values per
 // pixel, rows c' = X, Y, Z of Σ_out cmf·M) with the 3×(3·|in|) weights W[c][c'·|in| + j] =
 // output[c][c']·ē[in_j], so that W·K = output · K·ē (docs/fluorescence.md).
-void add_reradiation_terms(const spectral::SpectralImage& image, const RelightMatrix& matrix, const ReradiationWeights& k,
+void add_reradiation_terms(const SpectralImage& image, const RelightMatrix& matrix, const ReradiationWeights& k,
                            std::vector<float>& weights, std::vector<LayerTerm>& terms) {
   const std::size_t ni = k.in_bins.size();
   const int layers = static_cast<int>(image.lights.size());
   if (static_cast<int>(k.per_light.size()) != layers || k.cmf != matrix.options().cmf)
-    throw spectral::RuntimeError("relight: re-radiation weights do not match the image or the observer");
+    throw RuntimeError("relight: re-radiation weights do not match the image or the observer");
   const std::size_t nk = 3 * ni;
   weights.assign(static_cast<std::size_t>(layers) * 3 * nk, 0.0f);
   for (int l = 0; l < layers; ++l) {
     const auto& kl = k.per_light[static_cast<std::size_t>(l)];
     if (kl.size() != image.pixel_count() * nk)
-      throw spectral::RuntimeError("relight: re-radiation weights do not match the image");
+      throw RuntimeError("relight: re-radiation weights do not match the image");
     const ReradiationTermWeights wl = reradiation_term_weights(matrix, k, l);
     float* w = weights.data() + static_cast<std::size_t>(l) * 3 * nk;
     bool any = false;
@@ -77,7 +77,7 @@ ReradiationTermWeights reradiation_term_weights(const RelightMatrix& matrix, con
 
 std::vector<LightWeights> light_weights(const RelightMatrix& matrix, int layers, int bins, const std::string& what) {
   if (matrix.light_count() != layers || matrix.bin_count() != bins) {
-    throw spectral::RuntimeError("relight: matrix is " + std::to_string(matrix.light_count()) + " lights × " +
+    throw RuntimeError("relight: matrix is " + std::to_string(matrix.light_count()) + " lights × " +
                                  std::to_string(matrix.bin_count()) + " bins, " + what + " has " +
                                  std::to_string(layers) + " × " + std::to_string(bins));
   }
@@ -94,7 +94,7 @@ std::vector<LightWeights> light_weights(const RelightMatrix& matrix, int layers,
   return on;
 }
 
-void relight_into(const spectral::SpectralImage& image, const RelightMatrix& matrix, float* xyz_out,
+void relight_into(const SpectralImage& image, const RelightMatrix& matrix, float* xyz_out,
                   const ReradiationWeights* k) {
   const int n = image.bins.size();
   const int layers = static_cast<int>(image.lights.size());
@@ -102,7 +102,7 @@ void relight_into(const spectral::SpectralImage& image, const RelightMatrix& mat
   for (int l = 0; l < layers; ++l) {
     const auto& data = image.lights[static_cast<std::size_t>(l)].data;
     if (data.size() != image.pixel_count() * static_cast<std::size_t>(n)) {
-      throw spectral::RuntimeError("relight: layer " + image.lights[static_cast<std::size_t>(l)].name +
+      throw RuntimeError("relight: layer " + image.lights[static_cast<std::size_t>(l)].name +
                                    " has " + std::to_string(data.size()) + " values, expected " +
                                    std::to_string(image.pixel_count() * static_cast<std::size_t>(n)));
     }
@@ -132,7 +132,7 @@ void relight_into(const spectral::SpectralImage& image, const RelightMatrix& mat
   });
 }
 
-XyzImage relight_image(const spectral::SpectralImage& image, const RelightMatrix& matrix) {
+XyzImage relight_image(const SpectralImage& image, const RelightMatrix& matrix) {
   XyzImage out;
   out.width = image.width;
   out.height = image.height;
@@ -141,4 +141,4 @@ XyzImage relight_image(const spectral::SpectralImage& image, const RelightMatrix
   return out;
 }
 
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

@@ -1,13 +1,13 @@
 #pragma once
 // The relight row kernel, compiled for every SIMD level and run at the one
-// spectral::choose_simd_level picks (relight_simd.cpp, Highway; docs/relight.md, "SIMD levels").
+// choose_simd_level picks (relight_simd.cpp, Highway; docs/relight.md, "SIMD levels").
 #include <cstddef>
 #include <string>
 #include <vector>
 
 #include "prizma/spectral/simd_choice.h"
 
-namespace prizma::relight::detail {
+namespace prizma::spectral::detail {
 
 // One row of the relight XYZ = Σ_t W_t·V_t: terms with their own value counts, summed in one pass per
 // pixel. out[3x + c] = Σ_t Σ_j weights_t[c·n_t + j] · values_t[(first_pixel + x)·n_t + j], x in [0, width).
@@ -27,21 +27,15 @@ using RelightRowKernel = void (*)(const SimdTerm* terms, int term_count, std::si
 constexpr int kRelightSums = 16;
 
 // The levels the kernel is built for that this CPU runs, lowest first (Baseline always).
-std::vector<spectral::SimdLevel> relight_simd_levels();
-// The level spectral::choose_simd_level(SimdKernel::Relight, relight_simd_levels()) picks now.
+std::vector<SimdLevel> relight_simd_levels();
+// The level choose_simd_level(SimdKernel::Relight, relight_simd_levels()) picks now.
 // Throws InputError("PRIZMA_SIMD", …) for an unknown value of the variable.
-spectral::SimdLevel relight_simd_level();
+SimdLevel relight_simd_level();
 // The kernel at relight_simd_level(): look it up once per image, not per row.
 RelightRowKernel relight_row_kernel();
 // The kernel at `level` (one of relight_simd_levels()).
-RelightRowKernel relight_row_kernel(spectral::SimdLevel level);
+RelightRowKernel relight_row_kernel(SimdLevel level);
 // Highway's name of the target compiled for `level` ("AVX3", "AVX2", "SSE4", "EMU128"…), for labels.
-std::string relight_simd_target_name(spectral::SimdLevel level);
+std::string relight_simd_target_name(SimdLevel level);
 
-// The same for each kernel of this library (SimdKernel::Relight, CompressedFrame, HalfToFloat; the
-// Tracer's are render::supported_simd_levels()), for tests and benchmarks: its levels on this CPU,
-// lowest first, and the one the tools run it at now.
-std::vector<spectral::SimdLevel> kernel_simd_levels(spectral::SimdKernel kernel);
-spectral::SimdLevel kernel_simd_level(spectral::SimdKernel kernel);
-
-}  // namespace prizma::relight::detail
+}  // namespace prizma::spectral::detail

@@ -1,4 +1,4 @@
-#include "prizma/relight/output_image.h"
+#include "prizma/spectral/output_image.h"
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
@@ -8,17 +8,18 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <vector>
 
 #include "prizma/spectral/atomic_file.h"
 #include "prizma/spectral/output_group.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/image_io.h"
+#include "prizma/spectral/light_record.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 
 namespace fs = std::filesystem;
-using spectral::InputError;
 
 OutputFormat output_format_for(const fs::path& path, const std::string& input) {
   std::string ext = path.extension().string();
@@ -32,30 +33,56 @@ OutputFormat output_format_for(const fs::path& path, const std::string& input) {
 
 void check_output_path(const fs::path& path, const std::string& input) {
   output_format_for(path, input);
-  spectral::check_output_file(path, input);
+  check_output_file(path, input);
 }
 
 bool needs_transform(OutputFormat format, const OutputOptions& opts) {
   return format != OutputFormat::Exr || !opts.display.colour_space.empty();
 }
 
-spectral::DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts) {
-  spectral::DisplayOptions d = opts.display;
+DisplayOptions transform_options(OutputFormat format, const OutputOptions& opts) {
+  DisplayOptions d = opts.display;
   if (format != OutputFormat::Exr) d.colour_space.clear();
   return d;
 }
 
+ImageMetadata relight_metadata(const std::string& software, const std::string& source,
+                               const std::vector<std::string>& light_names, const std::vector<LightSpectrum>& lights,
+                               const RelightOptions& relight, const OutputOptions& output, const BinLayout& bins) {
+  std::vector<LightRecord> records;
+  for (std::size_t l = 0; l < light_names.size() && l < lights.size(); ++l)
+    records.push_back(light_record(light_names[l], lights[l].text));
+  std::ostringstream exposure;
+  exposure << relight.exposure_ev;
+  ImageMetadata md = {
+      {"Software", software},
+      {"prizma:source", source},
+      {"prizma:lights", light_records_json(records)},
+      {"prizma:exposureEV", exposure.str()},
+      {"prizma:cmf", observer_name(relight.cmf)},
+      {"prizma:units", relight.units == LightUnits::Absolute ? "absolute" : "relative-to-white"},
+      {"prizma:adaptation", relight.adapt_to_d65 ? "bradford-to-D65" : "none"},
+      {"prizma:binEdgesNm", bins.to_string()},
+  };
+  if (!output.display.colour_space.empty()) md.emplace_back("prizma:colourSpace", output.display.colour_space);
+  md.emplace_back("prizma:display", output.display.display);
+  return md;
+}
+
+void OutputOptions::validate(const std::string& bit_depth_input) const {
+  if (bit_depth != 8 && bit_depth != 16)
+    throw InputError(bit_depth_input, "must be 8 or 16 (got " + std::to_string(bit_depth) + ")");
+}
+
 void check_output_options(OutputFormat format, const OutputOptions& opts) {
-  if (opts.bit_depth != 8 && opts.bit_depth != 16) {
-    throw InputError("--bit-depth", "must be 8 or 16, not " + std::to_string(opts.bit_depth));
-  }
+  opts.validate("--bit-depth");
   if (format == OutputFormat::Jpeg && opts.bit_depth != 8) {
     throw InputError("--bit-depth", "JPEG is 8-bit only (got " + std::to_string(opts.bit_depth) + "; use .png or .tif for 16)");
   }
-  if (needs_transform(format, opts)) spectral::DisplayTransform check(transform_options(format, opts));
+  if (needs_transform(format, opts)) DisplayTransform check(transform_options(format, opts));
 }
 
-std::vector<float> to_display(const XyzImage& image, const spectral::DisplayTransform& display) {
+std::vector<float> to_display(const XyzImage& image, const DisplayTransform& display) {
   std::vector<float> rgb(image.xyz);
   for (float& v : rgb)
     if (!std::isfinite(v)) v = 0.0f;
@@ -88,7 +115,7 @@ std::optional<std::array<double, 8>> chromaticities_of(const Eigen::Matrix3d& xy
 // found from the XYZ unit vectors). Nothing for a colour space that is not linear.
 std::optional<std::array<float, 8>> exr_chromaticities(const OutputOptions& opts) {
   if (opts.display.colour_space.empty()) return std::array<float, 8>{1, 0, 0, 1, 0, 0, 1.0f / 3, 1.0f / 3};
-  const spectral::DisplayTransform transform(transform_options(OutputFormat::Exr, opts));
+  const DisplayTransform transform(transform_options(OutputFormat::Exr, opts));
   std::array<float, 9> unit{1, 0, 0, 0, 1, 0, 0, 0, 1}, half{0.5f, 0, 0, 0, 0.5f, 0, 0, 0, 0.5f};
   transform.apply(unit.data(), 3);
   transform.apply(half.data(), 3);
@@ -108,13 +135,13 @@ std::optional<std::array<float, 8>> exr_chromaticities(const OutputOptions& opts
 
 }  // namespace
 
-std::optional<spectral::PictureColourSpace> display_colour_space(const spectral::DisplayTransform& transform,
+std::optional<PictureColourSpace> display_colour_space(const DisplayTransform& transform,
                                                                  const std::string& name) {
-  const std::optional<spectral::DisplayMatrixCurve> split = transform.split_matrix_curve();
+  const std::optional<DisplayMatrixCurve> split = transform.split_matrix_curve();
   if (!split) return std::nullopt;
   const auto xy = chromaticities_of(split->matrix);
   if (!xy) return std::nullopt;
-  spectral::PictureColourSpace cs;
+  PictureColourSpace cs;
   cs.name = name;
   cs.chromaticities = *xy;
 
@@ -181,16 +208,16 @@ std::optional<spectral::PictureColourSpace> display_colour_space(const spectral:
 }
 
 void write_output_image(const fs::path& path, const XyzImage& image, const OutputOptions& opts,
-                        const ImageMetadata& metadata, const std::string& input, spectral::OutputGroup* group) {
+                        const ImageMetadata& metadata, const std::string& input, OutputGroup* group) {
   const OutputFormat format = output_format_for(path, input);
   check_output_path(path, input);
   check_output_options(format, opts);
 
   // Pixels: linear XYZ / colour space for EXR, display-encoded and clamped to [0, 1] otherwise.
   std::vector<float> pixels;
-  std::optional<spectral::PictureColourSpace> colour_space;
+  std::optional<PictureColourSpace> colour_space;
   if (needs_transform(format, opts)) {
-    const spectral::DisplayTransform transform(transform_options(format, opts));
+    const DisplayTransform transform(transform_options(format, opts));
     pixels = to_display(image, transform);
     if (format != OutputFormat::Exr) colour_space = display_colour_space(transform, opts.display.display);
   } else {
@@ -198,13 +225,13 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
     for (float& v : pixels)
       if (!std::isfinite(v)) v = 0.0f;
   }
-  spectral::PictureSpec spec;
+  PictureSpec spec;
   spec.width = image.width;
   spec.height = image.height;
-  spec.stored = spectral::PicturePixelType::Float;
+  spec.stored = PicturePixelType::Float;
   if (format != OutputFormat::Exr) {
     for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
-    spec.stored = opts.bit_depth == 16 ? spectral::PicturePixelType::UInt16 : spectral::PicturePixelType::UInt8;
+    spec.stored = opts.bit_depth == 16 ? PicturePixelType::UInt16 : PicturePixelType::UInt8;
   }
   // R, G, B in every format: an XYZ EXR holds X, Y, Z in them with XYZ's chromaticities (below), the
   // convention of OpenEXR (ImfChromaticities.h, "CIE XYZ"), so every RGBA reader gets the colours
@@ -239,9 +266,9 @@ void write_output_image(const fs::path& path, const XyzImage& image, const Outpu
     for (const auto& [key, value] : metadata) spec.attributes.emplace_back(key, value);
   }
 
-  spectral::write_atomically(path, [&](spectral::AtomicOutput& out) {
-    spectral::write_picture(out, spec, spectral::PicturePixelType::Float, pixels.data());
+  write_atomically(path, [&](AtomicOutput& out) {
+    write_picture(out, spec, PicturePixelType::Float, pixels.data());
   }, group);
 }
 
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

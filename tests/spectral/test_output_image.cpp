@@ -10,11 +10,11 @@
 #include <sstream>
 #include <string>
 
-#include "prizma/relight/output_image.h"
+#include "prizma/spectral/output_image.h"
 #include "prizma/spectral/error.h"
-#include "relight/relight_test_util.h"
+#include "spectral/relight_test_util.h"
 
-namespace prizma::relight {
+namespace prizma::spectral {
 namespace {
 
 namespace fs = std::filesystem;
@@ -103,4 +103,4 @@ TEST(OutputImage, WriteBeyondFileSizeLimitFailsForEveryFormatAndKeepsTheOldFile)
 }
 
 }  // namespace
-}  // namespace prizma::relight
+}  // namespace prizma::spectral

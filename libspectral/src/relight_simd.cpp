@@ -1,6 +1,6 @@
 // The relight inner loop XYZ = Σ_l M_l·T_l for a row of pixels, compiled by Highway for every x86
 // level (SSE4, AVX2, AVX-512 and the portable fallback) and run at the level
-// spectral::choose_simd_level picks for SimdKernel::Relight (hwy_levels.h).
+// choose_simd_level picks for SimdKernel::Relight (hwy_levels.h).
 //
 // Same bits at every level (and with every compiler). A pixel's products w·t go into 16 running
 // sums, value j into sum j mod 16 (two 8-float vectors on AVX2 and AVX-512, four of 4 on SSE4,
@@ -29,10 +29,10 @@
 #include <utility>
 #include <vector>
 
-#include "prizma/relight/relight_simd.h"
+#include "prizma/spectral/relight_simd.h"
 
 HWY_BEFORE_NAMESPACE();
-namespace prizma::relight::detail::HWY_NAMESPACE {
+namespace prizma::spectral::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 namespace {
@@ -185,49 +185,29 @@ void RelightRowTermsSimd(const SimdTerm* terms, int term_count, std::size_t firs
   }
 }
 
-}  // namespace prizma::relight::detail::HWY_NAMESPACE
+}  // namespace prizma::spectral::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "compressed_simd.h"
-#include "hwy_levels.h"
-#include "prizma/spectral/error.h"
+#include "prizma/spectral/hwy_levels.h"
 
-namespace prizma::relight::detail {
+namespace prizma::spectral::detail {
 
 HWY_EXPORT(RelightRowTermsSimd);
 
-std::vector<spectral::SimdLevel> relight_simd_levels() { return hwy_levels(HWY_DISPATCH_TABLE(RelightRowTermsSimd)); }
+std::vector<SimdLevel> relight_simd_levels() { return hwy_levels(HWY_DISPATCH_TABLE(RelightRowTermsSimd)); }
 
-RelightRowKernel relight_row_kernel(spectral::SimdLevel level) {
+RelightRowKernel relight_row_kernel(SimdLevel level) {
   return hwy_function(HWY_DISPATCH_TABLE(RelightRowTermsSimd), level);
 }
 
-spectral::SimdLevel relight_simd_level() {
-  return spectral::choose_simd_level(spectral::SimdKernel::Relight, relight_simd_levels());
+SimdLevel relight_simd_level() {
+  return choose_simd_level(SimdKernel::Relight, relight_simd_levels());
 }
 
 RelightRowKernel relight_row_kernel() { return relight_row_kernel(relight_simd_level()); }
 
-std::string relight_simd_target_name(spectral::SimdLevel level) { return hwy_target_name(level); }
+std::string relight_simd_target_name(SimdLevel level) { return hwy_target_name(level); }
 
-std::vector<spectral::SimdLevel> kernel_simd_levels(spectral::SimdKernel kernel) {
-  switch (kernel) {
-    case spectral::SimdKernel::CompressedFrame:
-      return compressed_frame_levels();
-    case spectral::SimdKernel::HalfToFloat:
-      return half_to_float_levels();
-    case spectral::SimdKernel::Tracer:
-      throw spectral::RuntimeError("kernel_simd_levels: the tracer's levels are render::supported_simd_levels()");
-    case spectral::SimdKernel::Relight:
-      break;
-  }
-  return relight_simd_levels();
-}
-
-spectral::SimdLevel kernel_simd_level(spectral::SimdKernel kernel) {
-  return spectral::choose_simd_level(kernel, kernel_simd_levels(kernel));
-}
-
-}  // namespace prizma::relight::detail
+}  // namespace prizma::spectral::detail
 #endif
