@@ -336,7 +336,8 @@ def _render(scene, scene_is_json, base_dir, samples, threads, seed, width, heigh
     return Image._from_native(native)
 
 
-def denoise(image, variance="propagate", window=5, patch=3, strength=0.45, centre_threshold=3.0, threads=0):
+def denoise(image, variance="propagate", window=5, patch=3, strength=0.45, centre_threshold=3.0, threads=0,
+            guides="luminance"):
     """The image denoised as ``prizma-render denoise`` denoises a file (docs/denoise.md); a new
     :class:`Image`.
 
@@ -352,13 +353,15 @@ def denoise(image, variance="propagate", window=5, patch=3, strength=0.45, centr
         strength: k of the patch distance (> 0); larger averages more and blurs more.
         centre_threshold: standard errors past which a neighbour is cut off (0: no such test).
         threads: worker threads, 0 for all cores. The result does not depend on it.
+        guides: "luminance" (default), or "features": the image's guide layers (``image.guides``,
+            a render with --features) as well (prizma-render denoise --guides features).
 
     The result's ``attributes["denoised"]`` records the method, parameters and guides, as the file
     ``write`` makes of it does (prizma:denoised). Raises InputError for an image without variance,
     one already denoised, or options out of range. The GIL is released while it runs.
     """
-    return Image._from_native(_prizma.denoise(image._native(), str(variance), window, patch, float(strength),
-                                              float(centre_threshold), threads))
+    return Image._from_native(_prizma.denoise(image._native(), str(variance), str(guides), window, patch,
+                                              float(strength), float(centre_threshold), threads))
 
 
 def metamer(albedo, match_light="D65", split_light="A", cmf="1931-2", bins=None, basis_size=20,

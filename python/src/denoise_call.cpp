@@ -12,8 +12,11 @@
 
 namespace prizma::python {
 
-py::dict denoise_image(const py::dict& image_dict, const std::string& variance, int window_radius_px,
-                       int patch_radius_px, double strength, double centre_threshold_se, int threads) {
+py::dict denoise_image(const py::dict& image_dict, const std::string& variance, const std::string& guides,
+                       int window_radius_px, int patch_radius_px, double strength, double centre_threshold_se,
+                       int threads) {
+  if (guides != "luminance" && guides != "features")
+    throw spectral::InputError("guides", "\"" + guides + "\" is neither \"luminance\" nor \"features\"");
   denoise::DenoiseOptions options;
   if (variance == "drop") {
     options.variance = denoise::VarianceOutput::Drop;
@@ -31,7 +34,8 @@ py::dict denoise_image(const py::dict& image_dict, const std::string& variance, 
     const WithoutGil released;
     std::optional<tbb::global_control> limit;
     if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
-    clean = denoise::denoise(raw, denoise::compute_weights(denoise::image_guides(raw), options));
+    clean = denoise::denoise(raw, denoise::compute_weights(
+                                      guides == "features" ? denoise::image_guides(raw) : denoise::luminance_guides(raw), options));
   }
   return image_to_py(std::move(clean));
 }

@@ -636,7 +636,7 @@ PYBIND11_MODULE(_prizma, m) {
   m.def("render", &prizma::python::render_scene, py::arg("scene"), py::arg("scene_is_json"), py::arg("base_dir"), py::arg("samples"),
         py::arg("threads"), py::arg("seed"), py::arg("width"), py::arg("height"), py::arg("bins"), py::arg("variance"),
         py::arg("samples_per_pass"), py::arg("progress"));
-  m.def("denoise", &prizma::python::denoise_image, py::arg("image"), py::arg("variance"), py::arg("window"),
+  m.def("denoise", &prizma::python::denoise_image, py::arg("image"), py::arg("variance"), py::arg("guides"), py::arg("window"),
         py::arg("patch"), py::arg("strength"), py::arg("centre_threshold"), py::arg("threads"));
   prizma::python::register_exit_hook();
 }

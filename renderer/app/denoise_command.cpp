@@ -23,7 +23,11 @@ namespace denoise = prizma::denoise;
 namespace spectral = prizma::spectral;
 using spectral::InputError;
 
-void add_denoise_options(CLI::App& app, denoise::DenoiseOptions& o, std::string& variance) {
+void add_denoise_options(CLI::App& app, denoise::DenoiseOptions& o, std::string& variance, std::string& guides) {
+  app.add_option("--guides", guides,
+                 "what the weights compare: luminance (default), or features: also the file's guide layers "
+                 "(--features; measured to help less so far: docs/denoise.md)")
+      ->check(CLI::IsMember({"luminance", "features"}));
   app.add_option("--variance", variance,
                  "variance layers of the output: propagate (Σ W²·Var, the filtered values' own noise) or drop")
       ->check(CLI::IsMember({"propagate", "drop"}));
@@ -39,10 +43,11 @@ void finish_denoise_options(denoise::DenoiseOptions& o, const std::string& varia
 }
 
 spectral::SpectralImage denoise_image(const spectral::SpectralImage& raw, const std::string& input,
-                                      const denoise::DenoiseOptions& options) {
+                                      const denoise::DenoiseOptions& options, bool features) {
   // The library names the image "image"; the user knows it by its file.
   try {
-    return denoise::denoise(raw, denoise::compute_weights(denoise::image_guides(raw), options));
+    return denoise::denoise(
+        raw, denoise::compute_weights(features ? denoise::image_guides(raw) : denoise::luminance_guides(raw), options));
   } catch (const InputError& e) {
     if (e.input() != "image") throw;
     throw InputError(input, e.reason());
@@ -58,10 +63,10 @@ std::string variance_note(const denoise::DenoiseOptions& options) {
 
 void add_render_denoise_options(CLI::App& app, bool& features, bool& denoise, std::string& keep_raw) {
   app.add_flag("--features", features,
-               "also write the denoiser's guide layers (depth and fraction of the first scattering; docs/spectral-exr.md)");
+               "also write the denoiser's guide layers (depth and fraction of the first scattering; docs/spectral-exr.md); "
+               "with --denoise, the weights use them");
   app.add_flag("--denoise", denoise,
-               "denoise the output after the last pass (implies --variance and --features; docs/denoise.md); the file "
-               "relights exactly");
+               "denoise the output after the last pass (implies --variance; docs/denoise.md); the file relights exactly");
   app.add_option("--keep-raw", keep_raw, "with --denoise: also write the raw render to this file (to resume or merge)")
       ->check(spectral::non_empty_path());
 }
@@ -79,10 +84,12 @@ void check_render_denoise(bool denoise, const std::string& keep_raw, bool shard,
                                       ", the raw samples it continues (--keep-raw " + resume + " updates those)");
 }
 
-spectral::SpectralImage denoise_render(const spectral::SpectralImage& raw, const std::string& output, bool quiet) {
+spectral::SpectralImage denoise_render(const spectral::SpectralImage& raw, const std::string& output, bool quiet,
+                                       bool features) {
   const denoise::DenoiseOptions options;
   const auto start = std::chrono::steady_clock::now();
-  spectral::SpectralImage clean = spectral::allocating("denoising", [&] { return denoise_image(raw, output, options); });
+  spectral::SpectralImage clean =
+      spectral::allocating("denoising", [&] { return denoise_image(raw, output, options, features); });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!quiet)
     std::cerr << "prizma-render: " << spectral::denoised_summary(clean.info) << " in " << seconds << " s\n"
@@ -96,7 +103,7 @@ int denoise_main(int argc, char** argv) {
                "guides, the same for every bin of every light, so the output relights exactly (docs/denoise.md).",
                std::string(kProgram) + " denoise"};
   app.set_version_flag("--version", spectral::prizma_version());
-  std::string input, output, variance = "propagate";
+  std::string input, output, variance = "propagate", guides = "luminance";
   bool no_verify = false, quiet = false;
   int threads = 0;
   denoise::DenoiseOptions options;
@@ -106,7 +113,7 @@ int denoise_main(int argc, char** argv) {
   app.add_option("-o,--output", output, "denoised spectral EXR (never the input)")
       ->required()
       ->check(spectral::non_empty_path());
-  add_denoise_options(app, options, variance);
+  add_denoise_options(app, options, variance, guides);
   app.add_flag("--no-verify", no_verify,
                "read the input even when its pixels do not match prizma:checksum (docs/spectral-exr.md)");
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
@@ -129,7 +136,7 @@ int denoise_main(int argc, char** argv) {
     const spectral::SpectralImage raw =
         spectral::allocating("reading " + input, [&] { return spectral::read_spectral_exr(input, read_options); });
     const spectral::SpectralImage clean =
-        spectral::allocating("denoising " + input, [&] { return denoise_image(raw, input, options); });
+        spectral::allocating("denoising " + input, [&] { return denoise_image(raw, input, options, guides == "features"); });
     spectral::ExrWriteOptions write_options;
     write_options.threads = threads;
     spectral::write_spectral_exr(output, clean, write_options);

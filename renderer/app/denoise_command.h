@@ -13,15 +13,17 @@ namespace prizma::render_app {
 // prizma-render denoise IN.exr -o OUT.exr [options] (argv[1] is "denoise").
 int denoise_main(int argc, char** argv);
 
-// The denoiser's options on a command line (--variance, --window, --patch, --strength,
+// The denoiser's options on a command line (--guides, --variance, --window, --patch, --strength,
 // --centre-threshold); finish_denoise_options turns the --variance word into the option.
-void add_denoise_options(CLI::App& app, prizma::denoise::DenoiseOptions& options, std::string& variance);
+void add_denoise_options(CLI::App& app, prizma::denoise::DenoiseOptions& options, std::string& variance,
+                         std::string& guides);
 void finish_denoise_options(prizma::denoise::DenoiseOptions& options, const std::string& variance);
 
-// The image denoised with guides from its own layers (image_guides: the luminance and any guide layers); the library's InputError for "image" is
-// rethrown naming `input` (the file, or the render's output).
+// The image denoised with guides from its own layers: the luminance, and with `features` its guide
+// layers too (image_guides). The library's InputError for "image" is rethrown naming `input` (the
+// file, or the render's output).
 spectral::SpectralImage denoise_image(const spectral::SpectralImage& raw, const std::string& input,
-                                      const prizma::denoise::DenoiseOptions& options);
+                                      const prizma::denoise::DenoiseOptions& options, bool features);
 
 // One line on what the output's variance layers hold.
 std::string variance_note(const prizma::denoise::DenoiseOptions& options);
@@ -33,8 +35,10 @@ void add_render_denoise_options(CLI::App& app, bool& features, bool& denoise, st
 // samples it continues would be lost: --keep-raw may name it).
 void check_render_denoise(bool denoise, const std::string& keep_raw, bool shard, const std::string& resume,
                           const std::string& output);
-// The render denoised with the default options after its last pass; unless quiet, says so on stderr.
-spectral::SpectralImage denoise_render(const spectral::SpectralImage& raw, const std::string& output, bool quiet);
+// The render denoised with the default options (and its guide layers with `features`) after its
+// last pass; unless quiet, says so on stderr.
+spectral::SpectralImage denoise_render(const spectral::SpectralImage& raw, const std::string& output, bool quiet,
+                                       bool features);
 
 // The raw render kept beside the denoised one (--keep-raw), written in the same output group.
 struct RawCopy {

@@ -315,7 +315,7 @@ int main(int argc, char** argv) {
     given.target_error = o.target_error;
     given.no_majorant_grid = o.no_majorant_grid;
     given.variance = o.variance || o.denoise;
-    given.features = o.features || (o.denoise && o.resume.empty());  // --resume: as the file was rendered
+    given.features = o.features;
     prizma::render_app::check_render_denoise(o.denoise, o.keep_raw, !o.samples.empty(), o.resume, o.output);
     given.half = o.half;
     if (!o.samples.empty()) {
@@ -348,7 +348,7 @@ int main(int argc, char** argv) {
       if (plan.complete) {
         check_outputs(o.output, "-o", o.preview, o.keep_raw);
         plan.previous.info.render_options = render::overrides_to_json(plan.overrides);
-        const auto clean = o.denoise ? std::optional(prizma::render_app::denoise_render(plan.previous, o.output, o.quiet))
+        const auto clean = o.denoise ? std::optional(prizma::render_app::denoise_render(plan.previous, o.output, o.quiet, o.features))
                                      : std::nullopt;
         write_outputs(clean ? *clean : plan.previous, o.output, plan.overrides.half, o.preview, plan.scene.lights,
                       plan.scene.source.parent_path(), o.threads,
@@ -431,7 +431,7 @@ int main(int argc, char** argv) {
     std::optional<spectral::SpectralImage> raw;
     if (o.denoise && !stats.interrupted) {
       raw = std::move(image);
-      image = prizma::render_app::denoise_render(*raw, output.string(), o.quiet);
+      image = prizma::render_app::denoise_render(*raw, output.string(), o.quiet, o.features);
     } else if (o.denoise && !o.quiet) {
       std::cerr << kProgram << ": interrupted: " << output.string() << " holds the raw samples, not denoised (--resume it with -o and --denoise)\n";
     }

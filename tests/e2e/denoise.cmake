@@ -52,10 +52,13 @@ prizma_denoise_case(resumed ${_render} "denoise|resumed.exr|-o|resumed_clean.exr
 # Guide layers (--features): merged, resumed and used as features; a file with them relights as before.
 prizma_denoise_case(features_merged ${_render} "merge|feat0.exr|feat1.exr|-o|feat.exr|-q" MUST_EXIST feat.exr
   FIXTURES_SETUP denoise_features)
-prizma_denoise_case(features_denoise ${_render} "denoise|feat.exr|-o|feat_clean.exr" MUST_EXIST feat_clean.exr
+prizma_denoise_case(features_denoise ${_render} "denoise|feat.exr|-o|feat_clean.exr|--guides|features" MUST_EXIST feat_clean.exr
   ERR_REGEX "denoised by prizma [^:]+: non-local means on luminance, depth, scatter; variance propagated"
   FIXTURES_REQUIRED denoise_features)
-prizma_denoise_case(features_resume ${_render} "--resume|feat0.exr|--spp|4|--denoise|-o|feat_rs.exr|-q" MUST_EXIST feat_rs.exr)
+prizma_denoise_case(features_resume ${_render} "--resume|feat0.exr|--spp|4|--denoise|--features|-o|feat_rs.exr"
+  MUST_EXIST feat_rs.exr ERR_REGEX "non-local means on luminance, depth, scatter; variance propagated")
+prizma_denoise_case(features_by_default_not_used ${_render} "denoise|feat.exr|-o|feat_lum.exr" MUST_EXIST feat_lum.exr
+  ERR_REGEX "non-local means on luminance; variance propagated" FIXTURES_REQUIRED denoise_features)
 prizma_denoise_case(features_relight ${_relight} "feat.exr|--light|side=A|-o|feat.png" MUST_EXIST feat.png
   FIXTURES_REQUIRED denoise_features)
 
@@ -100,7 +103,7 @@ prizma_denoised_case(resume_denoised ${_render} "--resume|clean.exr|--spp|8|-o|e
 # (resumable); refused on a shard and, with --resume, without an -o of its own.
 prizma_denoise_case(render_denoise ${_render} "${_tiny}|--denoise|--keep-raw|rd_raw.exr|--preview|rd.png|-o|rd.exr"
   MUST_EXIST "rd.exr|rd_raw.exr|rd.png"
-  ERR_REGEX "prizma-render: denoised by prizma [^:]+: non-local means on luminance, depth, scatter; variance propagated in [0-9.e-]+ s\nprizma-render: variance layers: Σ W²·Var"
+  ERR_REGEX "prizma-render: denoised by prizma [^:]+: non-local means on luminance; variance propagated in [0-9.e-]+ s\nprizma-render: variance layers: Σ W²·Var"
   FIXTURES_SETUP denoise_rendered)
 prizma_denoise_case(render_denoised_shows ${_relight} "rd.exr|-v|-o|rd_relit.png" MUST_EXIST rd_relit.png
   ERR_REGEX "prizma-relight: rd\\.exr: denoised by prizma" FIXTURES_REQUIRED denoise_rendered)

@@ -59,21 +59,24 @@ def test_refusals(tiny_scene, tiny_exr):
         prizma.denoise(raw, window=16)
     with pytest.raises(prizma.InputError, match=r"^threads: must be ≥ 0"):
         prizma.denoise(raw, threads=-1)
+    with pytest.raises(prizma.InputError, match=r'^guides: "depth" is neither "luminance" nor "features"$'):
+        prizma.denoise(raw, guides="depth")
 
 
 def test_render_denoise_is_denoise_of_the_kept_raw_render(tiny_scene, tmp_path):
     clean, raw = tmp_path / "clean.exr", tmp_path / "raw.exr"
-    run_tool("render", tiny_scene, "--denoise", "--keep-raw", raw, "-o", clean, "-q")
+    run_tool("render", tiny_scene, "--denoise", "--features", "--keep-raw", raw, "-o", clean, "-q")
     kept = prizma.read(raw)
     assert kept.attributes["denoised"] is None and set(kept.variance) == {"side", "sky"}
-    # --denoise implies --features: the guide layers, light-independent means in [0, 1].
+    # --features: the guide layers, light-independent means in [0, 1], which --denoise then uses.
     assert set(kept.guides) == {"depth", "scatter"} and set(kept.guide_variance) == {"depth", "scatter"}
     assert kept.guides["depth"].shape == (8, 8)
     assert 0.0 <= kept.guides["scatter"].min() and kept.guides["scatter"].max() <= 1.0
     assert 0.0 < kept.guides["scatter"].max() and kept.guides["depth"].min() < 1.0
-    ours, theirs = prizma.denoise(kept), prizma.read(clean)
+    ours, theirs = prizma.denoise(kept, guides="features"), prizma.read(clean)
     for name in kept.lights:
         np.testing.assert_array_equal(ours.lights[name], theirs.lights[name])
         np.testing.assert_array_equal(ours.variance[name], theirs.variance[name])
     assert theirs.attributes["denoised"]["guides"] == ["luminance", "depth", "scatter"]
     assert theirs.guides == {}  # the guides served the weights; the denoised file keeps none
+    assert prizma.denoise(kept).attributes["denoised"]["guides"] == ["luminance"]  # the default
