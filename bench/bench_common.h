@@ -11,6 +11,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "prizma/relight/light_spec.h"
@@ -90,9 +91,17 @@ inline render::Scene builtin_cube_sphere(int resolution) {
   return scene;
 }
 
-// A benchmark scene by name: "grey" (the cube with grey materials), "cube", "metamers", "mri".
-// Scene files come from data/scenes/; returns false (and says why) when a file is missing or fails.
+// A benchmark scene by name: "grey" (the cube with grey materials), "cube", "metamers", "mri",
+// "peer" (bench_peer.json, the pbrt-v4 anchor's Rayleigh medium), any other data/scenes/NAME.json
+// ("fluorescent_dye", "cloud_vdb", "sky_haze"), and NAME-grey for any of them: its materials replaced
+// by their bin averages (make_grey). Returns false (and says why) when a file is missing or fails.
 inline bool load_bench_scene(const std::string& name, render::Scene& out, std::string& why) {
+  constexpr std::string_view kGrey = "-grey";
+  if (name.size() > kGrey.size() && name.ends_with(kGrey)) {
+    if (!load_bench_scene(name.substr(0, name.size() - kGrey.size()), out, why)) return false;
+    out = make_grey(out);
+    return true;
+  }
   const fs::path dir = source_data_dir() / "scenes";
   auto from_file = [&](const std::string& file) {
     const fs::path p = dir / file;
@@ -116,9 +125,10 @@ inline bool load_bench_scene(const std::string& name, render::Scene& out, std::s
     if (name == "grey") out = make_grey(out);
     return true;
   }
-  if (name == "metamers") return from_file("metamers.json");
-  if (name == "mri") return from_file("mri.json");
-  why = "unknown scene \"" + name + "\" (known: grey, cube, metamers, mri)";
+  if (name == "peer") return from_file("bench_peer.json");
+  if (!name.empty() && name.find('/') == std::string::npos && fs::exists(dir / (name + ".json")))
+    return from_file(name + ".json");
+  why = "unknown scene \"" + name + "\" (known: grey, cube, peer, a data/scenes/NAME.json, NAME-grey)";
   return false;
 }
 

@@ -38,6 +38,7 @@ struct Options {
   std::string out = "docs/results/error_vs_time.csv";
   std::uint64_t seed = 1;
   bool references_only = false;
+  std::string bins;  // a bin layout for every scene instead of its own (empty: the scene's)
 };
 
 }  // namespace
@@ -45,10 +46,11 @@ struct Options {
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Error versus time of each wavelength-sampling method against a high-sample reference"};
-  app.add_option("--scenes", o.scenes, "grey, cube, metamers, mri");
+  app.add_option("--scenes", o.scenes, "grey, cube, metamers, mri, peer, any data/scenes/NAME, NAME-grey (bin-averaged)");
   app.add_option("--methods", o.methods,
                  "single, single-nogrid, spectral (auto event probabilities), spectral-nogrid, spectral-max, "
-                 "spectral-average, spectral-mixed, spectral-implicit, spectral-sobol, single-sobol (the Sobol' sampler)");
+                 "spectral-average, spectral-mixed, spectral-implicit, spectral-sobol, single-sobol (the Sobol' sampler), "
+                 "spectral-tracking (= spectral), spectral-mis");
   app.add_option("--size", o.size, "image width and height in pixels");
   app.add_option("--ref-spp", o.ref_spp, "reference samples per pixel (spectral tracking, grid)");
   app.add_option("--max-spp", o.max_spp, "largest sample count of the measured renders (powers of 2 up to it)");
@@ -57,6 +59,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out, "CSV output");
   app.add_option("--seed", o.seed, "seed of the measured renders (the reference uses seed + 1000003)");
   app.add_flag("--references-only", o.references_only, "only render (and cache) the references");
+  app.add_option("--bins", o.bins, "bin layout for every scene (e.g. linear:600:700:12), instead of its own");
   CLI11_PARSE(app, argc, argv);
 
   const std::vector<Method> known = {
@@ -70,6 +73,8 @@ int main(int argc, char** argv) {
       {"spectral-implicit", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Implicit},
       {"spectral-sobol", pr::WavelengthSampling::SpectralTracking, true, pr::EventProbabilities::Auto, pr::Sampler::Sobol},
       {"single-sobol", pr::WavelengthSampling::Single, true, pr::EventProbabilities::Auto, pr::Sampler::Sobol},
+      {"spectral-tracking", pr::WavelengthSampling::SpectralTracking, true},
+      {"spectral-mis", pr::WavelengthSampling::SpectralMis, true},
   };
   std::vector<Method> methods;
   for (const std::string& name : o.methods) {
@@ -93,6 +98,7 @@ int main(int argc, char** argv) {
         std::cerr << "skipping scene " << name << ": " << why << "\n";
         continue;
       }
+      if (!o.bins.empty()) scene.settings.bins = ps::BinLayout::parse(o.bins, "--bins");  // in the cache key
       scene.camera.width = o.size;
       scene.camera.height = o.size;
       scene.settings.threads = o.threads;

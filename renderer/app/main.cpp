@@ -263,8 +263,9 @@ int main(int argc, char** argv) {
       ->type_name("A:B");
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_option("--wavelength-sampling", o.wavelength_sampling,
-                 "spectral-tracking (all bins per path) or single (VPT: one wavelength per path)")
-      ->check(CLI::IsMember({"spectral-tracking", "single"}));
+                 "auto (default: by the scene), spectral-tracking (all bins per path), spectral-mis (all bins, "
+                 "one hero bin per path, spectral MIS) or single (VPT: one wavelength per path)")
+      ->check(CLI::IsMember({"auto", "spectral-tracking", "spectral-mis", "single"}));
   app.add_option("--sampler", o.sampler,
                  "independent (PCG per sample) or sobol (the first draws of each path from a scrambled Sobol' point)")
       ->check(CLI::IsMember({"independent", "sobol"}));
@@ -384,7 +385,8 @@ int main(int argc, char** argv) {
       std::cerr << kProgram << ": scene " << scene.source.string() << " (hash " << scene.hash << "), "
                 << scene.camera.width << "×" << scene.camera.height << ", " << st.bins.size() << " bins "
                 << st.bins.to_string() << ", samples " << st.sample_begin << ":" << st.sample_end << ", seed "
-                << st.seed << ", " << render::wavelength_sampling_name(st.wavelength_sampling) << ", "
+                << st.seed << ", " << render::wavelength_sampling_name(render::resolve_wavelength_sampling(scene))
+                << (st.wavelength_sampling == render::WavelengthSampling::Auto ? " (auto)" : "") << ", "
                 << render::sampler_name(st.sampler) << " sampler"
                 << (st.use_majorant_grid ? ", majorant grid" : ", global majorant") << "\n";
       std::cerr << kProgram << ": event probabilities ("

@@ -14,6 +14,7 @@ namespace prizma::render {
 namespace {
 float majorant_over_values(const Medium& medium, const std::vector<float>& sigma_t_max, float v_lo, float v_hi);
 CellControl control_over_values(const Medium& medium, const std::vector<float>& sigma_t_max, float v_lo, float v_hi);
+CellSpectralBound bound_over_values(const Medium& medium, float v_lo, float v_hi);
 
 // μ̄r for a cell of one material whose densities lie in [d_c, d_max]: at a point of density d the
 // tracer computes (d − d_c)·σt(λ) in float, at most (d_max − d_c)·σt_max by monotone rounding; one
@@ -49,6 +50,7 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
   }
   m_majorant.assign(static_cast<std::size_t>(m_cells[0]) * m_cells[1] * m_cells[2], 0.0f);
   m_control.assign(m_majorant.size(), CellControl{});
+  m_bound.assign(m_majorant.size(), CellSpectralBound{});
   bool blocks_fit = !medium.block_range.empty();
   for (int a = 0; a < 3; ++a) blocks_fit = blocks_fit && (span[a] % Volume::kBlockVoxels == 0 || m_cells[a] == 1);
   if (blocks_fit) {
@@ -61,10 +63,11 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
       const std::size_t row0 = (static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0];
       float* row = m_majorant.data() + row0;
       // Per cell of the row: its one material (kNone until a voxel is seen; `mixed` once a second
-      // material or an empty voxel is), and its least and largest density.
+      // material or an empty voxel is; `two` once a second material is: no spectral bound), and its
+      // least and largest density.
       std::vector<CellControl> ctl(static_cast<std::size_t>(m_cells[0]));
       std::vector<float> d_max(ctl.size(), 0.0f);
-      std::vector<char> mixed(ctl.size(), 0);
+      std::vector<char> mixed(ctl.size(), 0), two(ctl.size(), 0);
       for (auto& c : ctl) c.density = std::numeric_limits<float>::infinity();
       for (int z = cz * span[2]; z < z1; ++z)
         for (int y = cy * span[1]; y < y1; ++y)
@@ -80,12 +83,14 @@ MajorantGrid::MajorantGrid(const Medium& medium, const std::vector<float>& sigma
             float& cell = row[cx];
             cell = std::max(cell, dv * sigma_t_max[m]);
             CellControl& c = ctl[cx];
-            if (c.material != m) mixed[cx] = mixed[cx] || c.material != CellControl::kNone;
+            if (c.material != m && c.material != CellControl::kNone) mixed[cx] = two[cx] = 1;
             c.material = m;
             c.density = std::min(c.density, dv);
             d_max[cx] = std::max(d_max[cx], dv);
           }
       for (std::size_t cx = 0; cx < ctl.size(); ++cx) {
+        if (!two[cx] && ctl[cx].material != CellControl::kNone)  // every voxel's d·σt ≤ d_max·σt exactly
+          m_bound[row0 + cx] = CellSpectralBound{d_max[cx], ctl[cx].material};
         if (mixed[cx] || ctl[cx].material == CellControl::kNone) continue;
         ctl[cx].residual = residual_majorant(ctl[cx].density, d_max[cx], sigma_t_max[ctl[cx].material]);
         m_control[row0 + cx] = ctl[cx];
@@ -138,6 +143,27 @@ CellControl control_over_values(const Medium& medium, const std::vector<float>& 
   return c;
 }
 
+// The spectral bound of a cell whose points take values in [v_lo, v_hi]: when every rule that meets
+// the range names one material (so every point classifies to it or to empty space), that material
+// and the largest density of those rules' ramps there, one float ulp up (the tracer evaluates the
+// ramp at the point in double and rounds, as for the majorant); otherwise none.
+CellSpectralBound bound_over_values(const Medium& medium, float v_lo, float v_hi) {
+  CellSpectralBound b;
+  if (!(v_lo <= v_hi)) return b;
+  float d_max = 0.0f;
+  for (const MaterialRule& r : medium.rules) {
+    const double a = std::max<double>(r.value_lo, v_lo), z = std::min<double>(r.value_hi, v_hi);
+    if (!(a <= z)) continue;
+    const auto m = static_cast<std::uint16_t>(r.material);
+    if (b.material != CellSpectralBound::kNone && b.material != m) return CellSpectralBound{};
+    b.material = m;
+    d_max = std::max(d_max, static_cast<float>(r.density.max_over(a, z)));
+  }
+  if (b.material == CellSpectralBound::kNone || !(d_max > 0.0f)) return CellSpectralBound{};
+  b.density_max = std::nextafter(d_max, std::numeric_limits<float>::infinity());
+  return b;
+}
+
 }  // namespace
 
 void MajorantGrid::build_from_blocks(const Medium& medium, const std::vector<float>& sigma_t_max,
@@ -165,8 +191,9 @@ void MajorantGrid::build_from_blocks(const Medium& medium, const std::vector<flo
               v_lo = std::min(v_lo, r[0]);
               v_hi = std::max(v_hi, r[1]);
             }
-        m_majorant[(static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx] =
-            majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
+        const std::size_t k = (static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx;
+        m_majorant[k] = majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
+        m_bound[k] = bound_over_values(medium, v_lo, v_hi);
       }
   });
 }
@@ -230,6 +257,7 @@ void MajorantGrid::build_trilinear(const Medium& medium, const std::vector<float
           }
         const std::size_t k = (static_cast<std::size_t>(cz) * m_cells[1] + cy) * m_cells[0] + cx;
         m_majorant[k] = majorant_over_values(medium, sigma_t_max, v_lo, v_hi);
+        m_bound[k] = bound_over_values(medium, v_lo, v_hi);  // empty points (any_empty) stay below any bound
         if (!any_empty) m_control[k] = control_over_values(medium, sigma_t_max, v_lo, v_hi);
       }
   });

@@ -1,6 +1,7 @@
 #include "prizma/render/path_tracer.h"
 
 #include "path_tracer_internal.h"
+#include "prizma/render/render.h"
 // The tracer's parts, a file each (renderer/src/tracer/), compiled here as one translation unit: the
 // AVX2 and AVX-512 levels below flatten trace_baseline with everything it calls, which the compiler
 // can do only for code it sees in this unit (a part in a unit of its own would stay at the baseline
@@ -13,12 +14,14 @@
 #include "tracer/light_estimates.inl"
 #include "tracer/scattering.inl"
 #include "tracer/fluorescent_event.inl"
+#include "tracer/spectral_mis.inl"
 #include "tracer/guides.inl"
 
 namespace prizma::render {
 
 PathTracer::PathTracer(const Scene& scene, double lambda_lo_nm, double lambda_hi_nm, bool use_grid)
-    : m_medium(&scene.medium), m_simd(default_simd_level()), m_max_bounces(scene.settings.max_bounces) {
+    : m_medium(&scene.medium), m_simd(default_simd_level()), m_max_bounces(scene.settings.max_bounces),
+      m_mis(resolve_wavelength_sampling(scene) == WavelengthSampling::SpectralMis) {
   for (const MaterialEvents& e : choose_event_probabilities(scene.settings.event_probabilities, scene.medium.materials,
                                                             scene.settings.bins))
     m_events.push_back(e.scheme);
@@ -105,6 +108,9 @@ void PathTracer::prepare(PathScratch& s, int lanes) const {
   PathWork& w = s.work;
   for (auto* v : {&w.weight, &w.transmittance, &w.optical_depth, &w.phase, &w.sigma_a, &w.sigma_s, &w.sigma_n})
     v->assign(n, 0.0f);
+  if (m_mis)
+    for (auto* v : {&w.mis_pdf, &w.mis_rate, &w.mis_depth, &w.mis_ratio, &w.mis_factor, &w.mis_contribution})
+      v->assign(n, 0.0f);
   PathResult& out = s.out;
   out.environment.assign(n, 0.0f);
   out.emission.assign(n, 0.0f);
@@ -145,9 +151,11 @@ void PathTracer::trace(const Ray& ray, Rng& rng, PathScratch& s) const {
 
 void PathTracer::trace_baseline(const Ray& ray, Rng& rng, PathScratch& s) const {
   if (s.lanes == 1)
-    trace_lanes<1>(ray, rng, s);
+    trace_lanes<1, false>(ray, rng, s);
+  else if (m_mis)
+    trace_lanes<0, true>(ray, rng, s);
   else
-    trace_lanes<0>(ray, rng, s);
+    trace_lanes<0, false>(ray, rng, s);
 }
 
 // The other levels: trace_baseline with everything it calls in this file inlined (flatten) and
@@ -178,16 +186,21 @@ void PathTracer::trace_avx2(const Ray& ray, Rng& rng, PathScratch& s) const { tr
 void PathTracer::trace_avx512(const Ray& ray, Rng& rng, PathScratch& s) const { trace_baseline(ray, rng, s); }
 #endif
 #undef PRIZMA_TRACE_AVX512_TARGET
-template <int kLanes>
+template <int kLanes, bool kMis>
 void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) const {
   const int n = lane_count<kLanes>(s);
   MaterialCache& cache = s.cache;
   std::copy(s.in.lambda_nm.begin(), s.in.lambda_nm.end(), cache.lambda_nm.begin());
   cache.new_wavelengths();
   PathResult& out = s.out;
-  PathState<kLanes> v{n, lanes_of<kLanes>(s.work.weight, n), out.environment.data(), out.emission.data(),
-                      out.directional.data(), camera_ray.origin, camera_ray.direction};
+  const Lanes<kLanes> w = lanes_of<kLanes>(s.work.weight, n);
+  PathState<kLanes> v{n, w, kMis ? lanes_of<kLanes>(s.work.mis_pdf, n) : w, out.environment.data(),
+                      out.emission.data(), out.directional.data(), camera_ray.origin, camera_ray.direction};
   v.w = 1.0f;
+  if constexpr (kMis) {
+    v.mix = 1.0f;
+    v.hero = s.in.hero_lane;
+  }
   v.lanes(v.env) = 0.0f;
   v.lanes(v.em) = 0.0f;
   std::fill(out.directional.begin(), out.directional.end(), 0.0f);
@@ -203,7 +216,12 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   int bounces = 0;
   v.step_limit = s.counters.collisions + s.counters.shadow_steps + kMaxPathSteps;
   for (;;) {
-    switch (free_flight(v, rng, s)) {
+    FlightEnd flight;
+    if constexpr (kMis)
+      flight = free_flight_mis(v, rng, s);
+    else
+      flight = free_flight(v, rng, s);
+    switch (flight) {
       case FlightEnd::Abandoned:
         v.lanes(v.env) = kAbandoned;
         return;
@@ -224,7 +242,11 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
                                              : lanes_of<kLanes>(std::as_const(cache.g), n, v.material);
     const bool g_constant = kLanes == 1 || v.isotropic || m_g_constant[v.material];
     estimate_lights(v, g, g_constant, rng, s);
-    if (!sample_phase(v, g, g_constant, rng, s)) return;
+    if constexpr (kMis) {
+      if (!sample_phase_hero(v, g, g_constant, rng, s)) return;
+    } else {
+      if (!sample_phase(v, g, g_constant, rng, s)) return;
+    }
     if (!roulette(v, rng)) return;
     if (!intersect_box(Ray{v.pos, v.dir}, m_medium->bounds_min, m_medium->bounds_max, v.t_enter, v.t_exit)) {
       v.lanes(v.env) += v.w;
@@ -233,7 +255,8 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     }
   }
 }
-template void PathTracer::trace_lanes<1>(const Ray&, Rng&, PathScratch&) const;
-template void PathTracer::trace_lanes<0>(const Ray&, Rng&, PathScratch&) const;
+template void PathTracer::trace_lanes<1, false>(const Ray&, Rng&, PathScratch&) const;
+template void PathTracer::trace_lanes<0, false>(const Ray&, Rng&, PathScratch&) const;
+template void PathTracer::trace_lanes<0, true>(const Ray&, Rng&, PathScratch&) const;
 
 }  // namespace prizma::render

@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "prizma/render/camera.h"
+#include "prizma/render/event_probability.h"
 #include "prizma/render/film.h"
 #include "prizma/render/fluorescence.h"
 #include "prizma/render/path_tracer.h"
@@ -75,6 +76,7 @@ struct RenderContext {
   // (−2) or a directional light (its index in the tracer's directional results).
   std::vector<int> source;
   bool fluorescent = false;  // fluor.any in all-bins or single mode: paths may fluoresce
+  bool mis = false;          // spectral MIS with several lanes: each sample's hero lane is set
   // Single mode: pair_index[out·nb + in] is the bispectral pair of (out, in), −1 if none.
   std::vector<int> pair_index;
   Film& film;
@@ -105,6 +107,7 @@ class PixelRenderer {
       const double py = y + rng.uniform_double();
       const Ray ray = m_c.camera.generate(px, py);
       const WavelengthDraw draw = m_c.map.draw(rng, ps.in.lambda_nm.data());
+      if (m_c.mis) ps.in.hero_lane = m_c.map.hero_lane(st.seed, pix, s);
       m_c.tracer.trace(ray, rng, ps);
       ++ts.paths;
 
@@ -302,14 +305,40 @@ std::int64_t run_passes(const RenderContext& c, const Fold& fold, tbb::enumerabl
 }  // namespace
 
 std::string wavelength_sampling_name(WavelengthSampling w) {
-  return w == WavelengthSampling::Single ? "single" : "spectral-tracking";
+  switch (w) {
+    case WavelengthSampling::Auto: return "auto";
+    case WavelengthSampling::Single: return "single";
+    case WavelengthSampling::SpectralMis: return "spectral-mis";
+    case WavelengthSampling::SpectralTracking: break;
+  }
+  return "spectral-tracking";
 }
 
 WavelengthSampling parse_wavelength_sampling(std::string_view name, std::string_view input) {
-  if (name == "spectral-tracking") return WavelengthSampling::SpectralTracking;
-  if (name == "single") return WavelengthSampling::Single;
-  throw InputError(std::string(input),
-                   "unknown wavelength sampling \"" + std::string(name) + "\" (known: spectral-tracking, single)");
+  for (WavelengthSampling w : {WavelengthSampling::Auto, WavelengthSampling::SpectralTracking,
+                               WavelengthSampling::SpectralMis, WavelengthSampling::Single})
+    if (name == wavelength_sampling_name(w)) return w;
+  throw InputError(std::string(input), "unknown wavelength sampling \"" + std::string(name) +
+                                           "\" (known: auto, spectral-tracking, spectral-mis, single)");
+}
+
+WavelengthSampling resolve_wavelength_sampling(const Scene& scene) {
+  const WavelengthSampling w = scene.settings.wavelength_sampling;
+  const auto fluorescent = std::find_if(scene.medium.materials.begin(), scene.medium.materials.end(),
+                                        [](const Material& m) { return m.fluorescent; });
+  const bool any_fluorescent = fluorescent != scene.medium.materials.end();
+  if (w == WavelengthSampling::SpectralMis && any_fluorescent)
+    throw InputError("wavelength_sampling", "spectral-mis does not support fluorescent materials (material \"" +
+                                                fluorescent->name + "\" fluoresces): use spectral-tracking or auto");
+  if (w != WavelengthSampling::Auto) return w;
+  if (any_fluorescent) return WavelengthSampling::SpectralTracking;
+  // Spectral MIS where some material's extinction differs across the bins (docs/renderer.md, "Which
+  // scenes take spectral MIS", and the measurements in docs/results.md); with σt the same in every
+  // bin the lanes share their distances and spectral tracking was as good or better.
+  for (const MaterialEvents& e :
+       choose_event_probabilities(scene.settings.event_probabilities, scene.medium.materials, scene.settings.bins))
+    if (e.extinction_ratio > kMisExtinctionRatio) return WavelengthSampling::SpectralMis;
+  return WavelengthSampling::SpectralTracking;
 }
 
 std::string sampler_name(Sampler s) { return s == Sampler::Sobol ? "sobol" : "independent"; }
@@ -339,11 +368,12 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
     throw InputError("target_error", "must be ≥ 0, got " + std::to_string(st.target_error));
 
   const CameraModel camera(scene.camera);
+  const WavelengthSampling sampling = resolve_wavelength_sampling(scene);
   const PathTracer tracer(scene, bins.min_nm(), bins.max_nm(), st.use_majorant_grid);
   const int nl = static_cast<int>(scene.lights.size());
 
   LaneMode mode = LaneMode::AllBins;
-  if (st.wavelength_sampling == WavelengthSampling::Single)
+  if (sampling == WavelengthSampling::Single)
     mode = LaneMode::Single;
   else if (tracer.wavelength_independent())
     mode = LaneMode::Replicated;
@@ -403,7 +433,8 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
   });
 
   std::atomic<bool> pass_cut{false};
-  const RenderContext context{st,   camera, tracer, map, fluor, source, fluorescent, std::move(pair_index),
+  const bool mis = sampling == WavelengthSampling::SpectralMis && mode == LaneMode::AllBins;
+  const RenderContext context{st,   camera, tracer, map, fluor, source, fluorescent, mis, std::move(pair_index),
                               film, callbacks.cancel, pass_cut};
   bool interrupted = false;
   const std::int64_t done = fold ? run_passes(context, folded, states, callbacks, start, interrupted)
@@ -420,7 +451,7 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
   img.info.seed = st.seed;
   img.info.scene_hash = scene.hash;
   img.info.version = spectral::prizma_version();
-  img.info.wavelength_sampling = wavelength_sampling_name(st.wavelength_sampling);
+  img.info.wavelength_sampling = wavelength_sampling_name(sampling);
 
   if (stats_out) {
     RenderStats s;

@@ -159,6 +159,10 @@ ResumePlan plan_resume(const ResumeRequest& req) {
     o.half = o.half || given.half;
   }
   apply_overrides(plan.scene, o, recorded ? file + ": prizma:renderOptions " : "--");
+  // The estimator the held samples were rendered with, whatever the default has become since
+  // (auto resolves by the scene; a file of an earlier version holds spectral tracking's samples).
+  if (!info.wavelength_sampling.empty())
+    plan.scene.settings.wavelength_sampling = parse_wavelength_sampling(info.wavelength_sampling, file + ": prizma:wavelengthSampling");
   if (!plan.previous.lights.empty() && !plan.previous.lights.front().variance.empty())
     plan.scene.settings.write_variance = true;
   if (!plan.previous.guides.empty()) plan.scene.settings.write_guides = true;

@@ -734,9 +734,11 @@ void read_settings(const Reader& rd, const json& root, RenderSettings& s) {
   if (root.contains("max_bounces")) s.max_bounces = static_cast<int>(rd.integer(root.at("max_bounces"), "max_bounces", -1, kMaxBounces));
   if (root.contains("wavelength_sampling")) {
     const std::string w = rd.string(root.at("wavelength_sampling"), "wavelength_sampling");
-    if (w == "spectral-tracking") s.wavelength_sampling = WavelengthSampling::SpectralTracking;
+    if (w == "auto") s.wavelength_sampling = WavelengthSampling::Auto;
+    else if (w == "spectral-tracking") s.wavelength_sampling = WavelengthSampling::SpectralTracking;
+    else if (w == "spectral-mis") s.wavelength_sampling = WavelengthSampling::SpectralMis;
     else if (w == "single") s.wavelength_sampling = WavelengthSampling::Single;
-    else rd.fail("wavelength_sampling", "must be \"spectral-tracking\" or \"single\" (got \"" + w + "\")");
+    else rd.fail("wavelength_sampling", "must be \"auto\", \"spectral-tracking\", \"spectral-mis\" or \"single\" (got \"" + w + "\")");
   }
   if (root.contains("sampler"))
     s.sampler = parse_sampler(rd.string(root.at("sampler"), "sampler"), rd.input("sampler"));

@@ -25,6 +25,11 @@ prizma_fluorescence_e2e(relight $<TARGET_FILE:prizma-relight> "dye.exr|--light|k
 prizma_fluorescence_e2e(single $<TARGET_FILE:prizma-render>
   "${_fl_scene}|--wavelength-sampling|single|--spp|4|-o|single.exr|${_small}" MUST_EXIST single.exr
   FIXTURES_SETUP fluorescence_single)
+# Spectral MIS does not take fluorescent materials: asked for, it is refused (exit 2, one line naming
+# the material, no output); auto leaves the scene on spectral tracking (the shards above).
+prizma_fluorescence_e2e(mis_refused $<TARGET_FILE:prizma-render>
+  "${_fl_scene}|--wavelength-sampling|spectral-mis|--spp|2|-o|mis.exr|${_small}" EXPECT_RC 2 MUST_NOT_EXIST mis.exr
+  ERR_REGEX "prizma-render: error: wavelength_sampling: spectral-mis does not support fluorescent materials \\(material \"[^\"]+\" fluoresces\\)" ERR_LINES 1)
 prizma_fluorescence_e2e(single_relight $<TARGET_FILE:prizma-relight> "single.exr|--light|key=LED-V1|--light|sky=off|-o|single_violet.png"
   MUST_EXIST single_violet.png FIXTURES_REQUIRED fluorescence_single)
 

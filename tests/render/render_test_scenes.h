@@ -2,6 +2,7 @@
 // Tiny hand-built scenes for the renderer's tests: a box medium seen by an orthographic camera
 // looking down −z, so every pixel's ray crosses the box along z over its full depth.
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <random>
 #include <string>
@@ -15,6 +16,18 @@ namespace prizma::render::testing {
 
 inline constexpr double kSe = 3.0;  // tolerance of the statistical tests in standard errors (fixed seeds)
 inline constexpr double kPi = std::numbers::pi;
+
+// Every light layer (and variance layer) of a and b the same to the bit.
+inline bool same_bits(const spectral::SpectralImage& a, const spectral::SpectralImage& b) {
+  if (a.lights.size() != b.lights.size()) return false;
+  for (std::size_t l = 0; l < a.lights.size(); ++l) {
+    const auto& x = a.lights[l].data;
+    const auto& y = b.lights[l].data;
+    if (x.size() != y.size() || std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) != 0) return false;
+    if (a.lights[l].variance != b.lights[l].variance) return false;
+  }
+  return true;
+}
 
 inline Material make_material(spectral::Spectrum albedo, spectral::Spectrum sigma_t, spectral::Spectrum g) {
   Material m;

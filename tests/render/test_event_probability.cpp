@@ -114,6 +114,7 @@ TEST(EventProbability, OneLaneIsTheSameForEveryScheme) {
   for (EventProbabilities e : {EventProbabilities::Auto, EventProbabilities::Average, EventProbabilities::Mixed,
                                EventProbabilities::Implicit}) {
     s.settings.event_probabilities = e;
+    s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
     const auto img = render(s);
     for (std::size_t l = 0; l < ref.lights.size(); ++l) EXPECT_EQ(img.lights[l].data, ref.lights[l].data);
   }
@@ -121,6 +122,7 @@ TEST(EventProbability, OneLaneIsTheSameForEveryScheme) {
 
 TEST(EventProbability, AutoRendersAsTheSchemeItChooses) {
   Scene s = testing::chromatic_scene(8);
+  s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;
   const auto chosen = choose_event_probabilities(EventProbabilities::Auto, s.medium.materials[0], s.settings.bins).scheme;
   const auto a = render(s);
   s.settings.event_probabilities = chosen;
@@ -139,6 +141,7 @@ TEST(EventProbability, BeerLambertPerBinForEveryScheme) {
                                       Spectrum::constant(0.0)),
                         4, 8, 256);
     s.settings.event_probabilities = e;
+    s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
     const auto m = pixel_average(render(s), 0);
     for (int i = 0; i < 6; ++i) {
       const double a = 0.5 + 2.5 * (i / 6.0), b = 0.5 + 2.5 * ((i + 1) / 6.0);
@@ -153,6 +156,7 @@ TEST(EventProbability, ChromaticFurnaceIsOneForEveryScheme) {
   for (EventProbabilities e : kSchemes) {
     Scene s = testing::chromatic_furnace(0.6, 0.3, 8, 64);
     s.settings.event_probabilities = e;
+    s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
     const auto m = pixel_average(render(s), 0);
     for (int i = 0; i < 6; ++i)
       EXPECT_NEAR(m.mean[i], 1.0, kSe * m.se[i] + 1e-6) << event_probabilities_name(e) << " bin " << i;
@@ -167,6 +171,7 @@ testing::BinEstimate single_scattering(const Material& m, double theta0, std::ui
   s.settings.max_bounces = 1;
   s.settings.seed = seed;
   s.settings.event_probabilities = e;
+  s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
   return pixel_average(render(s), 0);
 }
 
@@ -212,6 +217,7 @@ TEST(EventProbability, SaturatedHalfSpaceMatchesChandrasekharForEveryScheme) {
                            testing::directional_light("sun", {std::sin(theta0), 0.0, mu0}), 16, 128);
     s.settings.seed = 13;
     s.settings.event_probabilities = e;
+    s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;  // the schemes are spectral tracking's
     const auto m = pixel_average(render(s), 0);
     for (int b = 0; b < 6; ++b) {
       EXPECT_NEAR(m.mean[b], expected[b], kSe * m.se[b])
@@ -233,6 +239,7 @@ TEST(EventProbability, PinnedValueOfTheImplicitScheme) {
   // sun layers of the determinism tests' chromatic box, 8 spp.
   Scene implicit = testing::chromatic_scene(8);
   implicit.settings.event_probabilities = EventProbabilities::Implicit;
+  implicit.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;
   const auto img = render(implicit);
   const auto env = pixel_average(img, 0), sun = pixel_average(img, 1);
   EXPECT_NEAR(env.mean[0], 0.803799102, 1e-6) << std::setprecision(9) << env.mean[0];
@@ -240,6 +247,7 @@ TEST(EventProbability, PinnedValueOfTheImplicitScheme) {
   // And the closed-form scale it must sit in: within 3 standard errors of the max scheme's render.
   Scene s = testing::chromatic_scene(8);
   s.settings.event_probabilities = EventProbabilities::Max;
+  s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;
   const auto mx = pixel_average(render(s), 0);
   EXPECT_NEAR(env.mean[0], mx.mean[0], 3.0 * std::hypot(env.se[0], mx.se[0]));
 }

@@ -127,7 +127,7 @@ TEST(SceneLoader, DefaultsWhenOptionalFieldsAreMissing) {
   EXPECT_EQ(s.settings.sample_end, 64);
   EXPECT_EQ(s.settings.seed, 1u);
   EXPECT_EQ(s.settings.max_bounces, -1);
-  EXPECT_EQ(s.settings.wavelength_sampling, WavelengthSampling::SpectralTracking);
+  EXPECT_EQ(s.settings.wavelength_sampling, WavelengthSampling::Auto);
   EXPECT_EQ(s.settings.sampler, Sampler::Independent);
   EXPECT_EQ(s.settings.event_probabilities, EventProbabilities::Auto);
   EXPECT_EQ(s.settings.bins, spectral::BinLayout());

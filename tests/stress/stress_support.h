@@ -48,6 +48,20 @@ inline ps::Spectrum log_ramp(double lo, double hi) {
   return ps::Spectrum(l, v);
 }
 
+// Bin average of exp(−σt(λ)·length) over each bin, by the midpoint rule on 0.01 nm steps (σt is the
+// piecewise-linear table the renderer interpolates; its integrand is smooth between table points).
+inline std::vector<double> bin_average_transmittance(const ps::Spectrum& sigma_t, const ps::BinLayout& bins, double length) {
+  std::vector<double> out;
+  for (int i = 0; i < bins.size(); ++i) {
+    const int steps = std::max(1, static_cast<int>(bins.width_nm(i) / 0.01));
+    const double h = bins.width_nm(i) / steps;
+    double sum = 0.0;
+    for (int k = 0; k < steps; ++k) sum += std::exp(-sigma_t.eval(bins.lo_nm(i) + (k + 0.5) * h) * length);
+    out.push_back(sum / steps);
+  }
+  return out;
+}
+
 // A medium of dims voxels over the box [lo, hi], every voxel holding material 0 at density 1, unless
 // `fill` says otherwise (voxel centres in [−1, 1]³ → density; 0 = empty).
 inline pr::Medium box_medium(std::array<int, 3> dims, const pr::Material& mat,

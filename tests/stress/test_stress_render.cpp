@@ -62,20 +62,6 @@ ps::SpectralImage run_case(const pr::Scene& scene, const std::string& what, Case
   return a4;
 }
 
-// Bin average of exp(−σt(λ)·length) over each bin, by the midpoint rule on 0.01 nm steps (σt is the
-// piecewise-linear table the renderer interpolates; its integrand is smooth between table points).
-std::vector<double> bin_average_transmittance(const ps::Spectrum& sigma_t, const ps::BinLayout& bins, double length) {
-  std::vector<double> out;
-  for (int i = 0; i < bins.size(); ++i) {
-    const int steps = std::max(1, static_cast<int>(bins.width_nm(i) / 0.01));
-    const double h = bins.width_nm(i) / steps;
-    double sum = 0.0;
-    for (int k = 0; k < steps; ++k) sum += std::exp(-sigma_t.eval(bins.lo_nm(i) + (k + 0.5) * h) * length);
-    out.push_back(sum / steps);
-  }
-  return out;
-}
-
 // Bernoulli standard error of an analog estimate of probability p from n samples: a floor for the
 // sample variance, which is 0 when every sample happened to agree.
 double bernoulli_sd(double p, std::int64_t n) { return std::sqrt(std::max(p * (1 - p), 1.0 / n) / n); }

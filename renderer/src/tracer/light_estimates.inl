@@ -19,8 +19,9 @@ void PathTracer::estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, boo
   // Next-event estimation of every light with its own layer (LightSampler: a direction toward the
   // light and its radiance / density), transmittance by ratio tracking up to the light (the box's
   // exit for distant lights). Environment maps weight the sample by the power heuristic against
-  // the density q(ω) the phase sampling draws ω with (q = Σ_j w_j p_j / Σ_j w_j when g varies
-  // across lanes); their escaping paths carry the complementary weight.
+  // the density q(ω) the phase sampling draws ω with (q = Σ_j m_j p_j / Σ_j m_j when g varies
+  // across lanes, m = v.mix: the weights w under spectral tracking, the lanes' densities ρ under
+  // spectral MIS); their escaping paths carry the complementary weight.
   const int n = v.n;
   const Lanes<kLanes>& w = v.w;
   const Lanes<kLanes> f = lanes_of<kLanes>(s.work.phase, n);
@@ -42,7 +43,7 @@ void PathTracer::estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, boo
       f = lane_map([cos_theta](float gi) { return hg_phase(cos_theta, gi); }, g);
       double k = ls.value;
       if (ls.pdf > 0.0) {
-        const float total = w.sum(), mix = sum_over(w * f, n);
+        const float total = v.mix.sum(), mix = sum_over(v.mix * f, n);
         k *= total > 0.0f ? power_heuristic(ls.pdf, mix / total) : 0.0;
       }
       const auto kf = static_cast<float>(std::min(k, kFloatMax));

@@ -10,6 +10,11 @@
 // 2014): where every point of the cell holds one material m with density ≥ d_c > 0, the control
 // extinction is σc(λ) = d_c·σt_m(λ) per lane (the path's wavelengths), and the residual majorant
 // μ̄r = (d_max − d_c)·max σt_m bounds σt − σc there; a homogeneous cell has μ̄r = 0.
+//
+// And its spectral bound, for spectral MIS's per-lane majorants (docs/renderer.md, "Spectral MIS"):
+// where every non-empty point of the cell holds one material m at density ≤ d_max, lane i's majorant
+// is d_max·σt_m(λ_i), exact at the path's own wavelengths and with no per-bin table (memory: 8 bytes
+// per cell whatever the bin count); elsewhere every lane takes the cell's majorant.
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
@@ -25,6 +30,13 @@ struct CellControl {
   static constexpr std::uint16_t kNone = 0xffff;  // = Medium::kEmpty
   float residual = 0.0f;  // μ̄r ≥ σt − σc at every point of the cell and wavelength of the render
   float density = 0.0f;   // d_c: σc(λ) = d_c·σt_material(λ)
+  std::uint16_t material = kNone;
+};
+
+// A cell's spectral bound: material kNone = none (the cell holds two materials, or none).
+struct CellSpectralBound {
+  static constexpr std::uint16_t kNone = 0xffff;  // = Medium::kEmpty
+  float density_max = 0.0f;  // d_max ≥ the density at every point of the cell holding `material`
   std::uint16_t material = kNone;
 };
 
@@ -44,6 +56,9 @@ class MajorantGrid {
   const CellControl& control(const std::array<int, 3>& c) const {
     return m_control[(static_cast<std::size_t>(c[2]) * m_cells[1] + c[1]) * m_cells[0] + c[0]];
   }
+  const CellSpectralBound& spectral_bound(const std::array<int, 3>& c) const {
+    return m_bound[(static_cast<std::size_t>(c[2]) * m_cells[1] + c[1]) * m_cells[0] + c[0]];
+  }
   float max_majorant() const { return m_max; }
   const Eigen::Vector3d& bounds_min() const { return m_min; }
   const Eigen::Vector3d& bounds_max() const { return m_max_corner; }
@@ -58,6 +73,7 @@ class MajorantGrid {
   Eigen::Vector3d m_min{0, 0, 0}, m_max_corner{0, 0, 0}, m_cell_size{1, 1, 1};
   std::vector<float> m_majorant;
   std::vector<CellControl> m_control;
+  std::vector<CellSpectralBound> m_bound;
   float m_max = 0.0f;
 };
 

@@ -23,6 +23,7 @@ namespace prizma::render {
 
 template <int kN>
 class ConstLanes;  // renderer/src/lanes.h
+struct TentativeCollision;  // renderer/src/majorant_sampler.h
 
 // Counters a path adds to (summed per thread, then over threads).
 struct PathCounters {
@@ -42,6 +43,9 @@ struct PathInputs {
   // lane takes no part in fluorescence.
   std::vector<float> lo_nm;     // [lanes]
   std::vector<float> width_nm;  // [lanes]
+  // Spectral MIS (WavelengthSampling::SpectralMis): the lane the path is sampled for, set before
+  // every trace() (WavelengthMap::hero_lane: a stratified draw over the bins).
+  int hero_lane = 0;
 };
 
 // The materials' spectra at the path's current wavelengths, evaluated the first time the path
@@ -78,6 +82,10 @@ struct PathWork {
   std::vector<float> phase;          // [lanes]
   std::vector<float> sigma_a, sigma_s, sigma_n;  // [lanes] at the current collision
   std::vector<float> zero_g;         // [lanes] g = 0: fluorescence's isotropic re-emission
+  // Spectral MIS (renderer/src/tracer/spectral_mis.inl), [lanes] each: the lanes' normalised path
+  // densities ρ, the current cell's per-lane majorants, their optical depths since the last
+  // collision, the transmittance ratios T_k/T_j, and an event's factors on densities and contributions.
+  std::vector<float> mis_pdf, mis_rate, mis_depth, mis_ratio, mis_factor, mis_contribution;
 };
 
 // What trace() returns per lane (overwritten by every path): radiance at unit white.
@@ -168,10 +176,18 @@ class PathTracer {
   void trace_avx512(const Ray& ray, Rng& rng, PathScratch& s) const;
   // One path, the way pbrt-v4's volpath reads: free flight (→ absorbed / scattered / escaped),
   // light estimates, phase sampling, roulette.
-  template <int kLanes>
+  // kMis: spectral MIS (one hero lane per path, renderer/src/tracer/spectral_mis.inl), else spectral
+  // tracking (every lane steering the path through the event probabilities).
+  template <int kLanes, bool kMis>
   void trace_lanes(const Ray& ray, Rng& rng, PathScratch& s) const;
   template <int kLanes>
   FlightEnd free_flight(PathState<kLanes>& v, Rng& rng, PathScratch& s) const;
+  // Spectral MIS: the hero's free flight, its phase lobe, and the update of the lanes' weights and
+  // densities by an event's factors a (contributions) and b (densities); false when nothing is left.
+  FlightEnd free_flight_mis(PathState<0>& v, Rng& rng, PathScratch& s) const;
+  bool collide_mis(PathState<0>& v, const TentativeCollision& tc, FlightEnd& end, Rng& rng, PathScratch& s) const;
+  bool sample_phase_hero(PathState<0>& v, ConstLanes<0> g, bool g_constant, Rng& rng, PathScratch& s) const;
+  bool mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) const;
   template <int kLanes>
   void estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng, PathScratch& s) const;
   template <int kLanes>
@@ -214,6 +230,7 @@ class PathTracer {
   bool m_trilinear = false;
   int m_max_bounces = -1;
   bool m_wavelength_independent = false;
+  bool m_mis = false;  // settings.wavelength_sampling is SpectralMis: trace() with several lanes takes it
   std::vector<EventProbabilities> m_events;  // per material: spectral tracking's scheme (event_probability.h)
 };
 

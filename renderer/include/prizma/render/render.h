@@ -99,8 +99,16 @@ void write_preview(const std::filesystem::path& path, const spectral::SpectralIm
 // format OpenImageIO writes); throws InputError(input, …).
 void check_preview_path(const std::filesystem::path& path, const std::string& input);
 
-// "spectral-tracking" / "single", as stored in prizma:wavelengthSampling and taken by the CLI.
+// "auto" / "spectral-tracking" / "spectral-mis" / "single", as taken by the CLI and the scene file;
+// prizma:wavelengthSampling stores the resolved one (never "auto").
 std::string wavelength_sampling_name(WavelengthSampling w);
 WavelengthSampling parse_wavelength_sampling(std::string_view name, std::string_view input = "wavelength sampling");
+// The estimator a render of `scene` runs (docs/renderer.md, "Which scenes take spectral MIS"): the
+// setting, or for Auto spectral MIS where some material's extinction ratio across the bins (largest
+// over least bin average) exceeds kMisExtinctionRatio and no material fluoresces, else spectral
+// tracking. Throws InputError("wavelength_sampling", …) for spectral-mis with a fluorescent material,
+// which it does not support.
+inline constexpr double kMisExtinctionRatio = 1.1;
+WavelengthSampling resolve_wavelength_sampling(const Scene& scene);
 
 }  // namespace prizma::render

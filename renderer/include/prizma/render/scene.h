@@ -123,8 +123,10 @@ struct Camera {
 };
 
 enum class WavelengthSampling {
+  Auto,              // by the scene (resolve_wavelength_sampling, render.h)
   SpectralTracking,  // every path carries all bins (Kutz et al. 2017)
   Single,            // VPT: one random wavelength per path, feeding one bin
+  SpectralMis,       // every path carries all bins, sampled for one hero bin, weighted by spectral MIS
 };
 
 struct RenderSettings {
@@ -133,7 +135,7 @@ struct RenderSettings {
   std::int64_t sample_end = 64;
   std::uint64_t seed = 1;
   int max_bounces = -1;               // −1 = unlimited (Russian roulette); ≥ 0 = cap
-  WavelengthSampling wavelength_sampling = WavelengthSampling::SpectralTracking;
+  WavelengthSampling wavelength_sampling = WavelengthSampling::Auto;
   Sampler sampler = Sampler::Independent;  // where a path's first random numbers come from (rng.h)
   // Spectral tracking's collision event probabilities (event_probability.h); Auto: chosen from the
   // materials' spectra when the tracer is built.

@@ -4,6 +4,8 @@
 // (spectral tracking); Replicated: one lane at the first bin's centre, copied to every bin (a
 // wavelength-independent medium); Single: VPT's method, one bin drawn per path, its lane × n into it.
 #include <algorithm>
+#include <cstdint>
+#include <vector>
 
 #include "prizma/render/rng.h"
 #include "prizma/spectral/bin_layout.h"
@@ -20,7 +22,8 @@ struct WavelengthDraw {
 
 class WavelengthMap {
  public:
-  WavelengthMap(LaneMode mode, const spectral::BinLayout& bins) : m_mode(mode), m_bins(bins) {}
+  WavelengthMap(LaneMode mode, const spectral::BinLayout& bins)
+      : m_mode(mode), m_bins(bins), m_hero_order(van_der_corput_order(lanes())) {}
 
   LaneMode mode() const { return m_mode; }
   int lanes() const { return m_mode == LaneMode::AllBins ? m_bins.size() : 1; }
@@ -63,12 +66,45 @@ class WavelengthMap {
     }
   }
 
+  // Spectral MIS's hero lane of a pixel's sample: (o + π(s mod n)) mod n, o hashed from (seed,
+  // pixel), π the lanes in van der Corput order (floor(n·φ₂(i)) for i = 0, 1, …, each lane at its
+  // first appearance: 0, 16, 8, 24, … for 32 bins; 0, 6, 3, 9, 1, 7, … for 12). Any n consecutive
+  // samples of a pixel take every bin once (stratified: over whole cycles the balance heuristic's
+  // choice of technique adds no variance), the first N < n of a cycle spread evenly over the bins
+  // (16 samples of 32 bins take every other bin, where plain turns would take half the spectrum), and
+  // each sample's lane is uniform over o. A function of (seed, pixel, sample) only: threads, shards
+  // and resumes give the same lanes.
+  int hero_lane(std::uint64_t seed, std::uint64_t pixel, std::int64_t sample) const {
+    const auto n = static_cast<std::uint64_t>(m_hero_order.size());
+    const std::uint64_t offset = splitmix64(splitmix64(seed) ^ pixel) % n;
+    return static_cast<int>((offset + m_hero_order[static_cast<std::uint64_t>(sample) % n]) % n);
+  }
+
   // Bin i's wavelength in the sample d: lo_i + u·Δλ_i.
   double lambda_at(const WavelengthDraw& d, int bin) const { return m_bins.lo_nm(bin) + d.u * m_bins.width_nm(bin); }
 
  private:
+  // hero_lane's π: the lanes 0 … n − 1 in the order floor(n·φ₂(i)) first reaches them, φ₂ the base-2
+  // radical inverse (every lane is reached: consecutive values of φ₂ over i < 2^k are 2^−k apart).
+  static std::vector<int> van_der_corput_order(int n) {
+    std::vector<int> order;
+    std::vector<char> seen(static_cast<std::size_t>(n), 0);
+    for (std::uint32_t i = 0; static_cast<int>(order.size()) < n; ++i) {
+      double phi = 0.0, digit = 0.5;
+      for (std::uint32_t k = i; k != 0; k >>= 1, digit *= 0.5)
+        if (k & 1u) phi += digit;
+      const int lane = std::min(n - 1, static_cast<int>(phi * n));
+      if (!seen[static_cast<std::size_t>(lane)]) {
+        seen[static_cast<std::size_t>(lane)] = 1;
+        order.push_back(lane);
+      }
+    }
+    return order;
+  }
+
   LaneMode m_mode;
   spectral::BinLayout m_bins;
+  std::vector<int> m_hero_order;  // hero_lane's π
 };
 
 }  // namespace prizma::render
