@@ -111,6 +111,17 @@ prizma_denoise_case(render_keep_raw_resumes ${_render} "--resume|rd_raw.exr|--sp
   FIXTURES_REQUIRED denoise_rendered)
 prizma_denoise_case(resume_and_denoise ${_render} "--resume|vshard0.exr|--spp|4|--denoise|-o|rs_clean.exr|--keep-raw|rs_raw.exr|-q"
   MUST_EXIST "rs_clean.exr|rs_raw.exr" FIXTURES_REQUIRED denoise_merged)
+# --keep-raw may name the resumed file itself: its raw samples are updated beside the denoised -o.
+prizma_denoise_e2e(raw_inplace ${_render} "${_tiny}|--variance|--samples|0:2|-o|inplace.exr|-q" MUST_EXIST inplace.exr
+  FIXTURES_SETUP denoise_inplace)
+prizma_denoise_e2e(resume_keep_raw_in_place ${_render}
+  "--resume|inplace.exr|--spp|4|--denoise|-o|inplace_clean.exr|--keep-raw|inplace.exr|-q"
+  MUST_EXIST "inplace_clean.exr|inplace.exr")
+set_tests_properties(denoise.e2e.resume_keep_raw_in_place PROPERTIES FIXTURES_REQUIRED denoise_inplace)
+prizma_denoise_e2e(resume_keep_raw_in_place_done ${_render} "--resume|inplace.exr|--spp|4"
+  ERR_REGEX "inplace\\.exr already holds samples 0:4, all that were asked for")
+set_tests_properties(denoise.e2e.resume_keep_raw_in_place_done PROPERTIES FIXTURES_REQUIRED denoise_inplace
+                     DEPENDS denoise.e2e.resume_keep_raw_in_place)
 prizma_denoise_case(keep_raw_alone ${_render} "${_tiny}|--keep-raw|kr.exr|-o|kr_out.exr" EXPECT_RC 2 ERR_LINES 1
   MUST_NOT_EXIST "kr.exr|kr_out.exr" ERR_REGEX "^prizma-render: error: --keep-raw: only with --denoise")
 prizma_denoise_case(denoise_shard ${_render} "${_tiny}|--samples|0:2|--denoise|-o|ds.exr" EXPECT_RC 2 ERR_LINES 1
