@@ -68,6 +68,37 @@ TEST(RenderGuides, LightIndependentThreadIndependentAndNothingElseChanges) {
   EXPECT_NE(other.lights.front().data, one.lights.front().data);
 }
 
+// The guides are recorded in the tracer's one loop, which spectral MIS shares with spectral tracking
+// and single-wavelength tracing: every mode writes them, bounded, and none changes a transport bit.
+TEST(RenderGuides, EveryWavelengthSamplingModeWritesThemAndKeepsTheTransport) {
+  for (const WavelengthSampling mode :
+       {WavelengthSampling::SpectralTracking, WavelengthSampling::SpectralMis, WavelengthSampling::Single}) {
+    SCOPED_TRACE(static_cast<int>(mode));
+    Scene s = chromatic_scene(8);
+    s.settings.wavelength_sampling = mode;
+    s.settings.write_variance = true;
+    const spectral::SpectralImage plain = render(s);
+    s.settings.write_guides = true;
+    const spectral::SpectralImage with = render(s);
+    ASSERT_EQ(with.guides.size(), 2u);
+    for (std::size_t l = 0; l < plain.lights.size(); ++l) {
+      EXPECT_EQ(with.lights[l].data, plain.lights[l].data);
+      EXPECT_EQ(with.lights[l].variance, plain.lights[l].variance);
+    }
+    const auto& depth = guide(with, "depth");
+    const auto& scatter = guide(with, "scatter");
+    bool some_scatter = false;
+    for (std::size_t p = 0; p < with.pixel_count(); ++p) {
+      EXPECT_GE(depth.value[p], 0.0f);
+      EXPECT_LE(depth.value[p], 1.0f);
+      EXPECT_GE(scatter.value[p], 0.0f);
+      EXPECT_LE(scatter.value[p], 1.0f);
+      some_scatter = some_scatter || (scatter.value[p] > 0.0f && depth.value[p] < 1.0f);
+    }
+    EXPECT_TRUE(some_scatter);
+  }
+}
+
 TEST(RenderGuides, ShardsMergeToTheFullRender) {
   Scene s = chromatic_scene(16);
   s.settings.write_guides = true;
