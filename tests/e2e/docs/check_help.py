@@ -104,7 +104,7 @@ def check_completion(prefix, work, env):
         pane.tmux("new-session", "-d", "-x", "120", "-y", "30", "-c", work, "bash", "--noprofile", "--rcfile", rc, "-i")
         pane.wait_for(r"(?m)^\$")
         for keys, want, what in (("prizma-render --wav\t", r"prizma-render --wavelength-sampling ", "an option name"),
-                                 ("spec\t", r"--wavelength-sampling spectral-tracking ", "an option's value"),
+                                 ("spectral-t\t", r"--wavelength-sampling spectral-tracking ", "an option's value"),
                                  ("scene_\t", r"spectral-tracking scene_a\.json", "a file name")):
             pane.tmux("send-keys", "-l", keys)
             screen = pane.wait_for(want)
