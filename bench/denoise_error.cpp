@@ -8,7 +8,7 @@
 //   bench_denoise_error [--scenes cube_sphere,mri_head,cloud_vdb,bench_peer] [--size 256]
 //       [--spp 16,64,256] [--bias-spp 4096] [--ref-spp 16384] [--threads 2]
 //       [--lights D65,F11,gaussian:450:10] [--cache build-bench/cache] [--out FILE.csv]
-//       [--images DIR] [--guides luminance] [--references-only]
+//       [--images DIR] [--guides luminance|features] [--features] [--references-only]
 //
 // relMSE = mean over pixels and X, Y, Z of (x − r)² / (r² + ε), ε = 0.01 (Rousselle et al. 2011,
 // Bitterli et al. 2016; white has Y = 1). The reference's own noise adds E[(r − E r)²/(r² + ε)] to
@@ -53,11 +53,12 @@ struct Options {
   bool references_only = false;
 };
 
-// The guides the weights are computed from. "luminance": the white luminance of the transport (all
-// the library computes today); guide layers the renderer writes will be read here.
+// The guides the weights are computed from. "luminance": the white luminance of the transport;
+// "features": that and the guide layers the renders then write (--features: depth, scatter).
 pd::DenoiseGuides make_guides(const ps::SpectralImage& img, const std::string& kind) {
   if (kind == "luminance") return pd::luminance_guides(img);
-  throw ps::InputError("--guides", "unknown guides \"" + kind + "\" (known: luminance)");
+  if (kind == "features") return pd::image_guides(img);
+  throw ps::InputError("--guides", "unknown guides \"" + kind + "\" (known: luminance, features)");
 }
 
 double rel_mse(const std::vector<float>& x, const std::vector<float>& r) {
@@ -88,6 +89,7 @@ pr::Scene load(const std::string& name, const Options& o) {
   pr::Scene s = pr::load_scene(path, {{"camera.width", std::to_string(o.size)}, {"camera.height", std::to_string(o.size)}});
   s.settings.threads = o.threads;
   s.settings.write_variance = true;
+  s.settings.write_guides = o.guides == "features";  // changes no bit of the transport
   return s;
 }
 
@@ -178,7 +180,8 @@ int main(int argc, char** argv) {
   app.add_option("--cache", o.cache, "folder of cached references and bias renders (outside git)");
   app.add_option("--out", o.out, "CSV output");
   app.add_option("--images", o.images, "folder to write the raw, denoised and reference EXR files into");
-  app.add_option("--guides", o.guides, "guides of the weights: luminance");
+  app.add_option("--guides", o.guides, "guides of the weights: luminance, or features (the renders' guide layers too)");
+  app.add_flag_callback("--features", [&o] { o.guides = "features"; }, "the same as --guides features");
   app.add_option("--seed", o.seed, "seed of the measured renders (the reference uses seed + 1000003)");
   app.add_flag("--references-only", o.references_only, "only render (and cache) the references and bias renders");
   CLI11_PARSE(app, argc, argv);

@@ -11,7 +11,11 @@
 #include <stdexcept>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "kernel_simd.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/tool_main.h"
 
 namespace prizma::denoise {
 
@@ -70,7 +74,28 @@ std::vector<float> apply(const FilterWeights& weights, const std::vector<float>&
   return out;
 }
 
+std::string denoise_record(const FilterWeights& weights) {
+  const DenoiseOptions& o = weights.options();
+  const bool propagate = o.variance == VarianceOutput::Propagate;
+  const nlohmann::json record = {
+      {"method", "non-local means"},
+      {"version", spectral::prizma_version()},
+      {"guides", weights.guide_names()},
+      {"variance", propagate ? "propagated" : "dropped"},
+      {"parameters",
+       {{"window_radius_px", o.window_radius_px},
+        {"patch_radius_px", o.patch_radius_px},
+        {"patch_k", o.patch_k},
+        {"patch_k_wide", o.patch_k_wide},
+        {"sure_radius_px", o.sure_radius_px},
+        {"centre_threshold_se", o.centre_threshold_se},
+        {"feature_k", o.feature_k},
+        {"feature_tau", o.feature_tau}}}};
+  return record.dump();
+}
+
 spectral::SpectralImage denoise(const spectral::SpectralImage& image, const FilterWeights& weights) {
+  require_raw_image(image);
   if (image.width != weights.width() || image.height != weights.height())
     throw std::invalid_argument("denoise: weights for " + std::to_string(weights.width()) + "×" +
                                 std::to_string(weights.height()) + " pixels applied to a " +
@@ -81,6 +106,7 @@ spectral::SpectralImage denoise(const spectral::SpectralImage& image, const Filt
   out.height = image.height;
   out.bins = image.bins;
   out.info = image.info;
+  out.info.denoised = denoise_record(weights);
   out.reradiation = image.reradiation;
   out.coefficient_criterion = image.coefficient_criterion;
   // Every per-pixel plane of every layer, each into its own output of the same size.
@@ -108,7 +134,7 @@ spectral::SpectralImage denoise(const spectral::SpectralImage& image, const Filt
 }
 
 spectral::SpectralImage denoise(const spectral::SpectralImage& image, const DenoiseOptions& options) {
-  return denoise(image, compute_weights(luminance_guides(image), options));
+  return denoise(image, compute_weights(image_guides(image), options));
 }
 
 }  // namespace prizma::denoise

@@ -45,7 +45,14 @@ void check_guides(const DenoiseGuides& g) {
   for (const GuidePlane& f : g.features) check_plane(f, pixels, false);
 }
 
+void require_raw_image(const spectral::SpectralImage& image) {
+  if (!image.info.denoised.empty())
+    throw spectral::InputError("image", "is already denoised (" + spectral::denoised_summary(image.info) +
+                                            "): denoise the raw render");
+}
+
 DenoiseGuides luminance_guides(const spectral::SpectralImage& image) {
+  require_raw_image(image);
   const std::string input = "image";
   if (image.compact())
     throw spectral::InputError(input, "a compact file (spectral-basis coefficients only) has no transport bins "
@@ -89,6 +96,12 @@ DenoiseGuides luminance_guides(const spectral::SpectralImage& image) {
     g.luminance.variance[p] = static_cast<float>(sigma * sigma);
   });
   check_guides(g);
+  return g;
+}
+
+DenoiseGuides image_guides(const spectral::SpectralImage& image) {
+  DenoiseGuides g = luminance_guides(image);
+  for (const spectral::GuideLayer& layer : image.guides) g.features.push_back({layer.name, layer.value, layer.variance});
   return g;
 }
 

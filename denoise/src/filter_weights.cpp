@@ -297,6 +297,12 @@ void FilterWeights::tile_kernels(const PixelRect& rect, std::vector<float>& out)
                   out.data() + o * count + static_cast<std::size_t>(y) * rect.width);
 }
 
+std::vector<std::string> FilterWeights::guide_names() const {
+  std::vector<std::string> names{m_guides->luminance.name.empty() ? std::string("luminance") : m_guides->luminance.name};
+  for (const GuidePlane& f : m_guides->features) names.push_back(f.name);
+  return names;
+}
+
 std::vector<float> FilterWeights::kernel(int x, int y) const {
   if (x < 0 || y < 0 || x >= m_width || y >= m_height)
     throw std::out_of_range("FilterWeights::kernel: pixel (" + std::to_string(x) + ", " + std::to_string(y) +

@@ -20,6 +20,11 @@ std::string missing_channels(const SpectralImage& image, bool has_top, bool cove
     const nlohmann::json options = nlohmann::json::parse(image.info.render_options, nullptr, false);
     rendered_with_variance = options.is_object() && options.value("variance", false) == true;
   }
+  // A denoised file whose variance was dropped (prizma:denoised "variance": "dropped") lacks them on purpose.
+  if (!image.info.denoised.empty()) {
+    const nlohmann::json denoised = nlohmann::json::parse(image.info.denoised, nullptr, false);
+    if (denoised.is_object() && denoised.value("variance", "") == "dropped") rendered_with_variance = false;
+  }
   if (!without.empty() && (!with.empty() || rendered_with_variance)) {
     std::string names;
     for (const auto& n : without) names += (names.empty() ? "" : ", ") + (n.empty() ? std::string("var") : n + ".var") + ".T.*";

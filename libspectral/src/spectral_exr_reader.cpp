@@ -18,6 +18,7 @@
 
 #include "bispectral_exr.h"
 #include "coefficients_exr.h"
+#include "guides_exr.h"
 #include "exr/attributes.h"
 #include "exr/channel_names.h"
 #include "exr/checksum.h"
@@ -319,6 +320,7 @@ void read_pixels(Imf::InputFile& file, const ChannelSets& sets, const std::vecto
     }
   }
   detail::add_reradiation_for_read(sets.reradiation, prefixes, lambdas, image, fb, dw, p);
+  detail::add_guides_for_read(header, image, fb, dw, p);
   const std::string* stored = opts.verify_checksum ? exr::find_string_attr(header, kAttrChecksum) : nullptr;
   // Spectral-basis coefficients: kept with read_coefficients (always in a compact file), else read
   // only to verify the checksum.
@@ -352,6 +354,7 @@ void read_pixels(Imf::InputFile& file, const ChannelSets& sets, const std::vecto
     }
   }
   detail::check_reradiation_finite(image, p);
+  detail::check_guides_finite(image, p);
 }
 
 }  // namespace

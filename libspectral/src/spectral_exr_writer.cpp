@@ -19,6 +19,7 @@
 
 #include "bispectral_exr.h"
 #include "coefficients_exr.h"
+#include "guides_exr.h"
 #include "exr/attributes.h"
 #include "exr/checksum.h"
 #include "exr/exr_common.h"
@@ -330,6 +331,7 @@ void write_spectral_exr(const fs::path& path, const SpectralImage& image, const 
   checksum += detail::add_reradiation_for_write(image, multi, half_out, header, fb, rerad_buffers, p);
   std::list<std::vector<half>> coefficient_buffers;  // spectral-basis coefficients (half whatever the pixel type)
   checksum += detail::add_coefficients_for_write(image, multi, header, fb, p, coefficient_buffers);
+  checksum += detail::add_guides_for_write(image, header, fb, p);  // float whatever the pixel type
   PreviewChannels preview;
   if (opts.write_preview) add_preview(preview, image, type, header, fb);
   exr::put_attributes(header, image, p);

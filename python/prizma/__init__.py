@@ -21,7 +21,7 @@ from . import _serve
 
 __all__ = [
     "Image", "InputError", "RuntimeFailure", "read", "write", "checksum", "relight", "spectrum", "xyz",
-    "lab", "delta_e2000", "named_spectra", "render", "metamer", "design_light", "version", "data_dir",
+    "lab", "delta_e2000", "named_spectra", "render", "denoise", "metamer", "design_light", "version", "data_dir",
     "serve", "Server",
 ]
 
@@ -56,12 +56,17 @@ class Image:
         bin_edges_nm: float64 array of the bins + 1 exact bin edges in nm.
         attributes: dict of the file's prizma: attributes: samples, sample_range, seed, scene_hash,
             version, wavelength_sampling, scene_path, render_options, lights (the recorded lights,
-            a list of dicts: name, direction, angularSizeDeg, spectrum) and is_prizma.
+            a list of dicts: name, direction, angularSizeDeg, spectrum), denoised (None for raw
+            Monte Carlo means, else prizma:denoised as a dict: method, version, guides, variance,
+            parameters; :func:`denoise`) and is_prizma.
         stats: for an image from :func:`render`, the render's statistics (paths, wall_seconds, …).
         reradiation: dict, light name → float32 array (height, width, pairs): the bispectral
             (fluorescence) terms M[out][in] of the pairs in ``reradiation_pairs``; empty for a file
             without fluorescence. Every light has the same pairs (docs/fluorescence.md).
         reradiation_pairs: int32 array (pairs, 2) of (in, out) bin indices, sorted, in ≠ out.
+        guides: dict, guide name → float32 array (height, width): the light-independent guide
+            layers of a render with --features (``depth``, ``scatter``; docs/spectral-exr.md), which
+            :func:`denoise` uses; ``guide_variance`` the same for their variances of the mean.
 
     Arrays read from a file are numpy arrays over the reader's own buffers (no copy).
     """
@@ -76,6 +81,8 @@ class Image:
         self.variance = dict(variance or {})
         self.attributes = dict(attributes or {})
         self.stats = None
+        self.guides = {}
+        self.guide_variance = {}
         self.reradiation = {}
         self.reradiation_pairs = _np.zeros((0, 2), dtype=_np.int32)
         if reradiation_pairs is not None:
@@ -126,15 +133,25 @@ class Image:
             attrs["lights"] = _json.loads(text) if text else []
         except ValueError:
             attrs["lights"] = text  # not JSON: kept as the file has it
+        denoised = attrs.get("denoised", "")
+        try:
+            attrs["denoised"] = _json.loads(denoised) if denoised else None
+        except ValueError:
+            attrs["denoised"] = denoised  # not JSON: kept as the file has it
         image = cls(d["lights"], d["bin_edges_nm"], d["variance"], attrs, d.get("reradiation"),
                     d.get("reradiation_pairs"))
         image.stats = d.get("stats")
+        image.guides = dict(d.get("guides") or {})
+        image.guide_variance = dict(d.get("guide_variance") or {})
         return image
 
     def _native(self):
         attrs = dict(self.attributes)
         lights = attrs.pop("lights", None)
         attrs.pop("is_prizma", None)
+        denoised = attrs.get("denoised")
+        attrs["denoised"] = "" if denoised is None else denoised if isinstance(denoised, str) else _json.dumps(
+            denoised, separators=(",", ":"))
         if isinstance(lights, str):
             attrs["lights_json"] = lights  # the writer refuses text its reader would refuse
         elif lights:
@@ -142,8 +159,11 @@ class Image:
                 attrs["lights_json"] = _json.dumps(lights, separators=(",", ":"), allow_nan=False)
             except (TypeError, ValueError) as e:
                 raise _input_error('attributes["lights"]', f"cannot be stored as JSON ({e})") from None
+        plane = lambda a: _np.asarray(a, dtype=_np.float32)[..., None]  # (height, width, 1), as a layer
         return {"bin_edges_nm": self.bin_edges_nm, "lights": self.lights, "variance": self.variance,
-                "attributes": attrs, "reradiation": self.reradiation, "reradiation_pairs": self.reradiation_pairs}
+                "attributes": attrs, "reradiation": self.reradiation, "reradiation_pairs": self.reradiation_pairs,
+                "guides": {k: plane(v) for k, v in self.guides.items()},
+                "guide_variance": {k: plane(v) for k, v in self.guide_variance.items()}}
 
     @property
     def wavelengths_nm(self):
@@ -329,6 +349,34 @@ def _render(scene, scene_is_json, base_dir, samples, threads, seed, width, heigh
         e.image = Image._from_native(partial) if partial is not None else None
         raise
     return Image._from_native(native)
+
+
+def denoise(image, variance="propagate", window=5, patch=3, strength=0.45, centre_threshold=3.0, threads=0,
+            guides="luminance"):
+    """The image denoised as ``prizma-render denoise`` denoises a file (docs/denoise.md); a new
+    :class:`Image`.
+
+    One kernel per pixel, computed from light-independent guides (the white-light luminance of all
+    lights and its variance), filters every bin of every light and every bispectral term, so
+    relighting the result under any spectra equals filtering the relit raw image with the same
+    kernels. The image needs variance layers (``render(..., variance=True)``, ``--variance``).
+
+    Args:
+        variance: "propagate" (the result's variance is Σ W²·Var, the filtered values' own noise with
+            the weights held fixed) or "drop" (no variance layers).
+        window, patch: kernel and patch radii in pixels (1–15, 0–7).
+        strength: k of the patch distance (> 0); larger averages more and blurs more.
+        centre_threshold: standard errors past which a neighbour is cut off (0: no such test).
+        threads: worker threads, 0 for all cores. The result does not depend on it.
+        guides: "luminance" (default), or "features": the image's guide layers (``image.guides``,
+            a render with --features) as well (prizma-render denoise --guides features).
+
+    The result's ``attributes["denoised"]`` records the method, parameters and guides, as the file
+    ``write`` makes of it does (prizma:denoised). Raises InputError for an image without variance,
+    one already denoised, or options out of range. The GIL is released while it runs.
+    """
+    return Image._from_native(_prizma.denoise(image._native(), str(variance), str(guides), window, patch,
+                                              float(strength), float(centre_threshold), threads))
 
 
 def metamer(albedo, match_light="D65", split_light="A", cmf="1931-2", bins=None, basis_size=20,

@@ -95,6 +95,14 @@ py::dict image_to_py(spectral::SpectralImage&& image) {
   for (auto& layer : image.lights)
     if (np > 0) reradiation[py::str(layer.name)] = take_vector(std::move(layer.reradiation), {h, w, np});
   out["reradiation"] = reradiation;
+  // Guide layers (prizma-render --features): name → H×W, and their variances.
+  py::dict guides, guide_variance;
+  for (auto& g : image.guides) {
+    if (!g.variance.empty()) guide_variance[py::str(g.name)] = take_vector(std::move(g.variance), {h, w});
+    guides[py::str(g.name)] = take_vector(std::move(g.value), {h, w});
+  }
+  out["guides"] = guides;
+  out["guide_variance"] = guide_variance;
   const spectral::SpectralExrInfo& info = image.info;
   py::dict a;
   a["samples"] = info.samples;
@@ -105,6 +113,7 @@ py::dict image_to_py(spectral::SpectralImage&& image) {
   a["wavelength_sampling"] = info.wavelength_sampling;
   a["scene_path"] = info.scene_path;
   a["render_options"] = info.render_options;
+  a["denoised"] = info.denoised;
   a["lights_json"] = spectral::light_records_json(info.light_records);
   a["is_prizma"] = info.is_prizma;
   out["attributes"] = a;
@@ -129,7 +138,7 @@ using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecas
 // SpectralImage ↔ Python. The Python side is a plain dict (prizma.Image wraps it):
 //   width, height, bin_edges_nm (float64 n+1), lights {name: float32 H×W×n}, variance {name: …},
 //   attributes {samples, sample_range, seed, scene_hash, version, wavelength_sampling, scene_path,
-//               render_options, lights_json, is_prizma}
+//               render_options, denoised, lights_json, is_prizma}
 
 template <typename T>
 T attribute_or(const py::dict& attrs, const char* key, T fallback) {
@@ -228,6 +237,20 @@ spectral::SpectralImage image_from_py(const py::dict& d) {
   } else if (!reradiation.empty()) {
     throw InputError("reradiation", "given without reradiation_pairs");
   }
+  // Guide layers: {name: H×W×1} and their variances (Image._native adds the last axis).
+  const py::dict guides = d.contains("guides") && !d["guides"].is_none() ? d["guides"].cast<py::dict>() : py::dict();
+  const py::dict guide_var =
+      d.contains("guide_variance") && !d["guide_variance"].is_none() ? d["guide_variance"].cast<py::dict>() : py::dict();
+  for (const auto& item : guides) {
+    spectral::GuideLayer& g = image.guides.emplace_back();
+    g.name = item.first.cast<std::string>();
+    g.value = layer_values(item.second, "guides[\"" + g.name + "\"]", image.width, image.height, 1);
+    if (guide_var.contains(item.first))
+      g.variance = layer_values(guide_var[item.first], "guide_variance[\"" + g.name + "\"]", image.width, image.height, 1);
+  }
+  for (const auto& item : guide_var)
+    if (!guides.contains(item.first))
+      throw InputError("guide_variance[\"" + item.first.cast<std::string>() + "\"]", "has no guide of that name");
   const py::dict attrs = d.contains("attributes") && !d["attributes"].is_none() ? d["attributes"].cast<py::dict>() : py::dict();
   spectral::SpectralExrInfo& info = image.info;
   info.samples = attribute_or<std::int64_t>(attrs, "samples", 0);
@@ -239,6 +262,7 @@ spectral::SpectralImage image_from_py(const py::dict& d) {
   info.wavelength_sampling = attribute_or<std::string>(attrs, "wavelength_sampling", "");
   info.scene_path = attribute_or<std::string>(attrs, "scene_path", "");
   info.render_options = attribute_or<std::string>(attrs, "render_options", "");
+  info.denoised = attribute_or<std::string>(attrs, "denoised", "");
   if (const std::string text = attribute_or<std::string>(attrs, "lights_json", ""); !text.empty())
     info.light_records = spectral::parse_light_records(text, "attributes[\"lights\"]");
   info.is_prizma = true;
@@ -582,6 +606,8 @@ void translate_exception(std::exception_ptr p) {
 
 }  // namespace
 
+spectral::SpectralImage prizma::python::image_from_dict(const py::dict& image) { return image_from_py(image); }
+
 PYBIND11_MODULE(_prizma, m) {
   m.doc() = "C++ half of the prizma module; use the functions of `prizma` (docs/python.md).";
   g_input_error = PyErr_NewExceptionWithDoc(
@@ -630,5 +656,7 @@ PYBIND11_MODULE(_prizma, m) {
         py::arg("source"), py::arg("lights"), py::arg("exposure"), py::arg("cmf"), py::arg("display"), py::arg("adapt"),
         py::arg("absolute"), py::arg("config"));
   m.def("relight_tool_path", &prizma::python::relight_tool_path);
+  m.def("denoise", &prizma::python::denoise_image, py::arg("image"), py::arg("variance"), py::arg("guides"), py::arg("window"),
+        py::arg("patch"), py::arg("strength"), py::arg("centre_threshold"), py::arg("threads"));
   prizma::python::register_exit_hook();
 }

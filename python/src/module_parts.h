@@ -35,6 +35,16 @@ std::string integer_text(const py::handle& value, const std::string& name);
 // A SpectralImage as the dict prizma.Image wraps (its arrays own the image's buffers, moved).
 py::dict image_to_py(spectral::SpectralImage&& image);
 
+// The dict prizma.Image._native() gives, as a SpectralImage (InputError naming the bad entry).
+spectral::SpectralImage image_from_dict(const py::dict& image);
+
+// prizma._prizma.denoise (denoise_call.cpp): variance "propagate" or "drop", guides "luminance" or
+// "features" (the image's guide layers too), the DenoiseOptions' window and patch radii, patch_k
+// (strength) and centre threshold; threads 0 = all cores.
+py::dict denoise_image(const py::dict& image, const std::string& variance, const std::string& guides,
+                       int window_radius_px, int patch_radius_px, double strength, double centre_threshold_se,
+                       int threads);
+
 // prizma._prizma.render (render_call.cpp): scene is a scene file's path or, with scene_is_json, a
 // scene's JSON text whose relative paths resolve against base_dir (nothing is written).
 py::dict render_scene(const std::string& scene, bool scene_is_json, const std::string& base_dir,

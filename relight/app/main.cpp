@@ -178,6 +178,10 @@ int run(const CliOptions& o) {
   relight::RelightSession session = spectral::allocating("reading " + o.input, [&] {
     return relight::RelightSession(spectral::read_spectral_exr(o.input, read_options), o.input, o.exact);
   });
+  // A denoised file says so wherever it is shown (docs/denoise.md, "Honesty").
+  if (const std::string denoised = spectral::denoised_summary(session.image().info);
+      !denoised.empty() && !o.quiet && (o.show || o.verbose || o.interactive || o.serve))
+    std::cerr << "prizma-relight: " << o.input << ": " << denoised << "\n";
   const relight::RelightSettings cli_settings = settings_from(o, session);
   session.apply(cli_settings, kCliNames);
   if (!o.output.empty()) {

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "denoise_command.h"
 #include "prizma/render/light_sampler.h"
 #include "prizma/render/render.h"
 #include "prizma/render/resume.h"
@@ -84,13 +85,18 @@ struct Options {
   std::vector<std::string> defines;  // -D KEY=VALUE, in order
   bool quiet = false;
   bool verbose = false;
+  bool features = false;  // --features: guide layers for the denoiser
+  bool denoise = false;   // --denoise: the output is denoised after the last pass (denoise_command.h)
+  std::string keep_raw;   // --keep-raw FILE: the raw render too
 };
 
 // Refuses before any work outputs that cannot be written (spectral::check_output_file: a folder, a
 // device, a FIFO, a missing or read-only folder, a file the run reads, …), a preview in a format that
 // prizma-relight does not write, and a preview that is the same file as the output.
-void check_outputs(const std::filesystem::path& output, const std::string& output_input, const std::string& preview) {
+void check_outputs(const std::filesystem::path& output, const std::string& output_input, const std::string& preview,
+                   const std::string& keep_raw = "") {
   std::vector<std::pair<std::filesystem::path, std::string>> outputs{{output, output_input}};
+  if (!keep_raw.empty()) outputs.emplace_back(keep_raw, "--keep-raw");
   if (!preview.empty()) {
     spectral::check_output_path(preview, "--preview");
     outputs.emplace_back(preview, "--preview");
@@ -135,14 +141,16 @@ class ProgressBar {
 };
 
 // The EXR and the preview appear together or not at all (a full disk on the preview leaves neither).
+// With --denoise --keep-raw, `raw` is the raw render and its file, written with them.
 void write_outputs(const spectral::SpectralImage& image, const std::filesystem::path& output, bool half,
-                   const std::string& preview, int threads) {
+                   const std::string& preview, int threads, const prizma::render_app::RawCopy& raw = {}) {
   spectral::OutputGroup outputs;
   spectral::ExrWriteOptions wo;
   wo.pixel_type = half ? spectral::ExrPixelType::Half : spectral::ExrPixelType::Float;
   wo.threads = threads;  // --threads holds for OpenEXR's encoding too
   wo.group = &outputs;
   spectral::write_spectral_exr(output, image, wo);
+  if (raw.image != nullptr) spectral::write_spectral_exr(raw.path, *raw.image, wo);
   if (!preview.empty()) {
     render::PreviewOptions po;
     po.source = output.string();
@@ -219,12 +227,14 @@ int inspect_main(int argc, char** argv);  // inspect.cpp
 int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "merge") return merge_main(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "inspect") return inspect_main(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "denoise") return prizma::render_app::denoise_main(argc, argv);
 
   CLI::App app{"Renders a spectral volume scene to a spectral OpenEXR file: per pixel, per light and per bin\n"
                "the transport under unit white light, ready for prizma-relight.\n"
                "  prizma-render SCENE.json -o OUT.exr [options]\n"
                "  prizma-render merge a.exr b.exr ... -o all.exr\n"
-               "  prizma-render inspect VOLUME|SCENE   (values, histogram, material ranges)",
+               "  prizma-render inspect VOLUME|SCENE   (values, histogram, material ranges)\n"
+               "  prizma-render denoise raw.exr -o clean.exr   (docs/denoise.md)",
                kProgram};
   app.set_version_flag("--version", spectral::prizma_version());
   // Examples (tests/e2e/docs/check_help.py checks that every option they use exists).
@@ -234,6 +244,7 @@ int main(int argc, char** argv) {
              "  prizma-render scene.json --samples 0:128 -o a.exr    (a shard; prizma-render merge a.exr b.exr -o all.exr)\n"
              "  prizma-render --resume part.exr --spp 256           (continue an interrupted render)\n"
              "  prizma-render inspect head.nii.gz                   (the values, to choose material ranges)\n"
+             "  prizma-render scene.json --denoise -o clean.exr     (or: prizma-render denoise raw.exr -o clean.exr)\n"
              "Docs: share/doc/prizma/renderer.md, scene-format.md; man prizma-render.");
   Options o;
   app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own")
@@ -265,6 +276,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-majorant-grid", o.no_majorant_grid, "one global majorant instead of the macrocell grid");
   app.add_flag("--variance", o.variance, "also write variance-of-the-mean layers");
   app.add_flag("--half", o.half, "write half floats (refused where values exceed half's range)");
+  prizma::render_app::add_render_denoise_options(app, o.features, o.denoise, o.keep_raw);
   app.add_option("--preview", o.preview,
                  "also write the default relight, as prizma-relight OUT -o PREVIEW does (.png, .tif, .jpg, .exr)")
       ->check(spectral::non_empty_path());
@@ -306,7 +318,9 @@ int main(int argc, char** argv) {
     if (!o.sampler.empty()) given.sampler = o.sampler;
     given.target_error = o.target_error;
     given.no_majorant_grid = o.no_majorant_grid;
-    given.variance = o.variance;
+    given.variance = o.variance || o.denoise;
+    given.features = o.features;
+    prizma::render_app::check_render_denoise(o.denoise, o.keep_raw, !o.samples.empty(), o.resume, o.output);
     given.half = o.half;
     if (!o.samples.empty()) {
       if (o.spp) throw InputError("--samples", "give either --samples or --spp");
@@ -327,7 +341,7 @@ int main(int argc, char** argv) {
       render::ResumeRequest req{o.resume, o.scene, given, o.spp, !o.no_verify};
       render::ResumePlan plan = render::plan_resume(req);
       // In place: the output (by default the file itself) replaces it only once complete.
-      spectral::allow_in_place_update(o.resume, {"-o", "--resume"});
+      spectral::allow_in_place_update(o.resume, {"-o", "--resume", "--keep-raw"});
       std::error_code ec;
       if (plan.complete && (o.output.empty() || std::filesystem::equivalent(o.output, o.resume, ec))) {
         if (!o.quiet)
@@ -336,9 +350,12 @@ int main(int argc, char** argv) {
         return spectral::kExitOk;
       }
       if (plan.complete) {
-        check_outputs(o.output, "-o", o.preview);
+        check_outputs(o.output, "-o", o.preview, o.keep_raw);
         plan.previous.info.render_options = render::overrides_to_json(plan.overrides);
-        write_outputs(plan.previous, o.output, plan.overrides.half, o.preview, o.threads);
+        const auto clean = o.denoise ? std::optional(prizma::render_app::denoise_render(plan.previous, o.output, o.quiet, o.features))
+                                     : std::nullopt;
+        write_outputs(clean ? *clean : plan.previous, o.output, plan.overrides.half, o.preview, o.threads,
+                      {o.keep_raw.empty() ? nullptr : &plan.previous, o.keep_raw});
         return spectral::kExitOk;
       }
       scene = std::move(plan.scene);
@@ -362,7 +379,8 @@ int main(int argc, char** argv) {
     std::filesystem::path output = o.output;
     if (output.empty()) output = o.resume.empty() ? scene.output : std::filesystem::path(o.resume);
     if (output.empty()) throw InputError("-o", "no output file: give -o or set \"output\" in the scene");
-    check_outputs(output, !o.output.empty() ? "-o" : !o.resume.empty() ? "--resume" : o.scene + ": output", o.preview);
+    check_outputs(output, !o.output.empty() ? "-o" : !o.resume.empty() ? "--resume" : o.scene + ": output", o.preview,
+                  o.keep_raw);
 
     for (const std::string& w : scene.warnings) std::cerr << kProgram << ": warning: " << w << "\n";
     if (o.verbose) {
@@ -413,7 +431,15 @@ int main(int argc, char** argv) {
       image.info.render_options = render::overrides_to_json(recorded);  // the target, not the union
     }
 
-    write_outputs(image, output, half, o.preview, o.threads);
+    // --denoise after the last pass; an interrupted render stays raw, to be resumed.
+    std::optional<spectral::SpectralImage> raw;
+    if (o.denoise && !stats.interrupted) {
+      raw = std::move(image);
+      image = prizma::render_app::denoise_render(*raw, output.string(), o.quiet, o.features);
+    } else if (o.denoise && !o.quiet) {
+      std::cerr << kProgram << ": interrupted: " << output.string() << " holds the raw samples, not denoised (--resume it with -o and --denoise)\n";
+    }
+    write_outputs(image, output, half, o.preview, o.threads, {raw && !o.keep_raw.empty() ? &*raw : nullptr, o.keep_raw});
 
     if (stats.nan_or_inf_count > 0)
       std::cerr << kProgram << ": warning: " << stats.nan_or_inf_count

@@ -22,12 +22,19 @@ Film::Film(Layout spec) : m_layout(std::move(spec)) {
   m_live.total_sum.assign(adaptive ? pixels : 0, 0.0);
   m_live.total_sq.assign(adaptive ? pixels : 0, 0.0);
   m_live.sum_fl.assign(pixels * m_per_pixel_fl, 0.0);
+  m_live.sum_g.assign(pixels * m_layout.guides.size(), 0.0);
+  m_live.sum_g_sq.assign(pixels * m_layout.guides.size(), 0.0);
   m_live.count.assign(pixels, 0);
   m_live.converged.assign(pixels, 0);
 }
 
-bool Film::add_sample(std::size_t pix, const double* v, const double* vf) {
+bool Film::add_sample(std::size_t pix, const double* v, const double* vf, const double* g) {
   Sums& s = m_live;
+  const std::size_t ng = m_layout.guides.size();
+  for (std::size_t k = 0; k < ng; ++k) {
+    s.sum_g[pix * ng + k] += g[k];
+    s.sum_g_sq[pix * ng + k] += g[k] * g[k];
+  }
   if (m_per_pixel_fl > 0) {
     double* acc_fl = s.sum_fl.data() + pix * m_per_pixel_fl;
     for (std::size_t k = 0; k < m_per_pixel_fl; ++k) acc_fl[k] += vf[k];
@@ -89,6 +96,21 @@ spectral::SpectralImage Film::image(const std::vector<std::string>& names) const
           layer.variance[pix * nb + i] = static_cast<float>(var / n);
         }
       }
+    }
+  }
+  const std::size_t ng = m_layout.guides.size();
+  for (std::size_t k = 0; k < ng; ++k) {
+    spectral::GuideLayer& guide = img.guides.emplace_back();
+    guide.name = m_layout.guides[k];
+    guide.value.assign(pixels, 0.0f);
+    guide.variance.assign(pixels, 0.0f);
+    for (std::size_t pix = 0; pix < pixels; ++pix) {
+      const double n = static_cast<double>(s.count[pix]);
+      const double mean = n > 0 ? s.sum_g[pix * ng + k] / n : 0.0;
+      guide.value[pix] = static_cast<float>(mean);
+      if (n > 1)
+        guide.variance[pix] =
+            static_cast<float>(std::max(0.0, (s.sum_g_sq[pix * ng + k] / n - mean * mean) * n / (n - 1.0)) / n);
     }
   }
   if (m_per_pixel_fl > 0) {

@@ -74,6 +74,48 @@ std::vector<Light> lights_from_image(const spectral::SpectralImage& image) {
   return out;
 }
 
+// One per-pixel plane of the shards merged into `mean` (and `variance`, when with_variance): means
+// weighted by sample counts; variances of the mean recombined as in Chan et al.'s parallel algorithm,
+// M2 = Σ M2_i + Σ n_i·(mean_i − mean)², with M2_i = (n_i − 1)·s_i² and s_i² = n_i·(variance of the
+// mean); unlike Σx² − n·mean² this does not cancel when the variance is small next to mean².
+// plane(s) gives shard s's (values, variances).
+template <class Plane>
+void merge_plane(const std::vector<spectral::SpectralImage>& shards, std::int64_t total, bool with_variance,
+                 const Plane& plane, std::vector<float>& mean, std::vector<float>& variance) {
+  const double n_total = static_cast<double>(total);
+  const std::size_t size = mean.size();
+  std::vector<double> sum(size, 0.0);
+  for (const auto& s : shards) {
+    const std::vector<float>& src = *plane(s).first;
+    const double n = static_cast<double>(s.info.samples);
+    for (std::size_t k = 0; k < size; ++k) sum[k] += n * static_cast<double>(src[k]);
+  }
+  for (std::size_t k = 0; k < size; ++k) sum[k] /= n_total;  // now the mean
+  variance.clear();
+  if (with_variance && total > 1) {
+    std::vector<double> m2(size, 0.0);
+    for (const auto& s : shards) {
+      const auto [src, src_var] = plane(s);
+      const double n = static_cast<double>(s.info.samples);
+      for (std::size_t k = 0; k < size; ++k) {
+        const double d = static_cast<double>((*src)[k]) - sum[k];
+        m2[k] += (n - 1.0) * n * static_cast<double>((*src_var)[k]) + n * d * d;
+      }
+    }
+    variance.resize(size);
+    for (std::size_t k = 0; k < size; ++k) variance[k] = static_cast<float>(std::max(0.0, m2[k] / (n_total - 1.0)) / n_total);
+  } else if (with_variance) {
+    variance.assign(size, 0.0f);
+  }
+  for (std::size_t k = 0; k < size; ++k) mean[k] = static_cast<float>(sum[k]);
+}
+
+void require_raw_samples(const spectral::SpectralImage& image, const std::string& name) {
+  if (!image.info.denoised.empty())
+    throw InputError(name, "is " + spectral::denoised_summary(image.info) +
+                               ": samples cannot be added to filtered values (merge or --resume the raw renders, then denoise)");
+}
+
 spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards,
                                      const std::vector<std::string>& names) {
   if (shards.empty()) throw InputError("merge", "no shards to merge");
@@ -99,6 +141,7 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
     for (std::size_t l = 0; l < s.lights.size(); ++l)
       if (s.lights[l].name != first.lights[l].name) refuse("lights");
     if (s.info.samples <= 0) throw InputError(name(k), "holds no samples");
+    require_raw_samples(s, name(k));
     if (!(s.reradiation == first.reradiation)) refuse("bispectral channels");
     for (const auto& l : s.lights) all_variance = all_variance && !l.variance.empty();
     const auto r = s.info.sample_range.empty()
@@ -126,41 +169,16 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
   std::vector<SampleRange> ranges;
   for (const auto& h : held) ranges.push_back(h.range);
 
-  // Means weighted by sample counts. Variances of the mean recombined as in Chan et al.'s parallel
-  // algorithm: M2 = Σ M2_i + Σ n_i·(mean_i − mean)², with M2_i = (n_i − 1)·s_i² and s_i² = n_i·(variance
-  // of the mean); unlike Σx² − n·mean² this does not cancel when the variance is small next to mean².
+  // Means weighted by sample counts, variances of the mean recombined (merge_plane).
   spectral::SpectralImage out = first;
   std::int64_t total = 0;
   for (const auto& s : shards) total += s.info.samples;
   const double n_total = static_cast<double>(total);
   for (std::size_t l = 0; l < out.lights.size(); ++l) {
     auto& layer = out.lights[l];
-    const std::size_t size = layer.data.size();
-    std::vector<double> sum(size, 0.0);
-    for (const auto& s : shards) {
-      const auto& src = s.lights[l];
-      const double n = static_cast<double>(s.info.samples);
-      for (std::size_t k = 0; k < size; ++k) sum[k] += n * static_cast<double>(src.data[k]);
-    }
-    for (std::size_t k = 0; k < size; ++k) sum[k] /= n_total;  // now the mean
-    layer.variance.clear();
-    if (all_variance && total > 1) {
-      std::vector<double> m2(size, 0.0);
-      for (const auto& s : shards) {
-        const auto& src = s.lights[l];
-        const double n = static_cast<double>(s.info.samples);
-        for (std::size_t k = 0; k < size; ++k) {
-          const double d = static_cast<double>(src.data[k]) - sum[k];
-          m2[k] += (n - 1.0) * n * static_cast<double>(src.variance[k]) + n * d * d;
-        }
-      }
-      layer.variance.resize(size);
-      for (std::size_t k = 0; k < size; ++k)
-        layer.variance[k] = static_cast<float>(std::max(0.0, m2[k] / (n_total - 1.0)) / n_total);
-    } else if (all_variance) {
-      layer.variance.assign(size, 0.0f);
-    }
-    for (std::size_t k = 0; k < size; ++k) layer.data[k] = static_cast<float>(sum[k]);
+    merge_plane(shards, total, all_variance, [l](const spectral::SpectralImage& s) {
+      return std::pair(&s.lights[l].data, &s.lights[l].variance);
+    }, layer.data, layer.variance);
     if (!out.reradiation.empty()) {  // bispectral terms: the same weighted mean
       std::vector<double> rs(layer.reradiation.size(), 0.0);
       for (const auto& s : shards)
@@ -168,6 +186,19 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
           rs[k] += static_cast<double>(s.info.samples) * static_cast<double>(s.lights[l].reradiation[k]);
       for (std::size_t k = 0; k < rs.size(); ++k) layer.reradiation[k] = static_cast<float>(rs[k] / n_total);
     }
+  }
+  // Guide layers (--features): merged alike when every shard has the same ones, else dropped.
+  bool same_guides = true;
+  for (const auto& s : shards) {
+    same_guides = same_guides && s.guides.size() == first.guides.size();
+    for (std::size_t g = 0; same_guides && g < s.guides.size(); ++g)
+      same_guides = s.guides[g].name == first.guides[g].name && !s.guides[g].variance.empty();
+  }
+  if (!same_guides) out.guides.clear();
+  for (std::size_t g = 0; g < out.guides.size(); ++g) {
+    merge_plane(shards, total, true, [g](const spectral::SpectralImage& s) {
+      return std::pair(&s.guides[g].value, &s.guides[g].variance);
+    }, out.guides[g].value, out.guides[g].variance);
   }
   out.info.samples = total;
   out.info.sample_range = format_sample_ranges(ranges);

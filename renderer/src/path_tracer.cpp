@@ -16,6 +16,7 @@
 #include "tracer/fluorescent_event.inl"
 #include "tracer/spectral_mis.inl"
 #include "tracer/shadow_mis.inl"
+#include "tracer/guides.inl"
 
 namespace prizma::render {
 
@@ -206,6 +207,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   v.lanes(v.em) = 0.0f;
   std::fill(out.directional.begin(), out.directional.end(), 0.0f);
   out.fl_active = false;
+  begin_guides(out);
 
   if (!intersect_box(camera_ray, m_medium->bounds_min, m_medium->bounds_max, v.t_enter, v.t_exit)) {
     v.lanes(v.env) = 1.0f;
@@ -232,6 +234,7 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
         add_escape(v.dir, v.phase_pdf, v.w.data(), v.dir_out, s);
         return;
       case FlightEnd::Scattered:
+        if (bounces == 0) record_first_scattering(v.pos, v.t_enter, camera_ray, *m_medium, out);
         break;
     }
     if (m_max_bounces >= 0 && bounces >= m_max_bounces) return;

@@ -33,6 +33,15 @@ using spectral::InputError;
 // Automatic pass size: about this many paths per pass.
 constexpr std::int64_t kPathsPerPass = std::int64_t{1} << 20;
 
+// The guide layers of --features (docs/spectral-exr.md, "Guide layers"), per sample from the path's
+// result: the depth of the first scattering as a fraction of the bounds' diagonal (1: none), and
+// whether it scattered (the pixel's mean: the fraction of paths that scatter).
+const std::vector<std::string> kGuideNames = {"depth", "scatter"};
+void guide_sample(const PathResult& r, double* g) {
+  g[0] = r.scattered ? static_cast<double>(r.first_scatter_depth) : 1.0;
+  g[1] = r.scattered ? 1.0 : 0.0;
+}
+
 struct ThreadState {
   PathScratch path;
   std::vector<double> value;     // [light][bin] of one sample
@@ -123,7 +132,9 @@ class PixelRenderer {
         std::fill(v, v + per_pixel, 0.0);
         std::fill(ts.value_fl.begin(), ts.value_fl.end(), 0.0);
       }
-      if (m_c.film.add_sample(pix, v, ts.value_fl.data())) {
+      double guides[2];
+      guide_sample(ps.out, guides);
+      if (m_c.film.add_sample(pix, v, ts.value_fl.data(), guides)) {
         ++ts.converged;
         return;
       }
@@ -402,6 +413,7 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
   if (fluorescent && !fold) layout.bispectral = fluor.pairs;  // folded: all on the diagonal
   layout.variance = st.write_variance;
   layout.target_error = st.target_error;
+  if (st.write_guides) layout.guides = kGuideNames;
   Film film(std::move(layout));
 
   tbb::enumerable_thread_specific<ThreadState> states([&] {

@@ -33,6 +33,7 @@ void apply_overrides(Scene& scene, const RenderOverrides& o, const std::string& 
   if (o.target_error) st.target_error = *o.target_error;
   if (o.no_majorant_grid) st.use_majorant_grid = false;
   if (o.variance) st.write_variance = true;
+  if (o.features) st.write_guides = true;
 }
 
 std::string overrides_to_json(const RenderOverrides& o) {
@@ -46,6 +47,7 @@ std::string overrides_to_json(const RenderOverrides& o) {
   if (o.target_error) j["target-error"] = *o.target_error;
   if (o.no_majorant_grid) j["no-majorant-grid"] = true;
   if (o.variance) j["variance"] = true;
+  if (o.features) j["features"] = true;
   if (o.half) j["half"] = true;
   if (o.samples) j["samples"] = o.samples->to_string();
   return j.dump();
@@ -78,6 +80,9 @@ RenderOverrides overrides_from_json(const std::string& text, const std::string& 
     } else if (key == "target-error") {
       if (!v.is_number() || !(v.get<double>() >= 0.0)) throw bad(key);
       o.target_error = v.get<double>();
+    } else if (key == "features") {
+      if (!v.is_boolean()) throw bad(key);
+      o.features = v.get<bool>();
     } else if (key == "no-majorant-grid" || key == "variance" || key == "half") {
       if (!v.is_boolean()) throw bad(key);
       (key == "variance" ? o.variance : key == "half" ? o.half : o.no_majorant_grid) = v.get<bool>();
@@ -97,6 +102,7 @@ ResumePlan plan_resume(const ResumeRequest& req) {
   spectral::ExrReadOptions read_options;
   read_options.verify_checksum = req.verify_checksum;
   plan.previous = spectral::read_spectral_exr(req.file, read_options);
+  require_raw_samples(plan.previous, file);
   const auto& info = plan.previous.info;
   if (!info.is_prizma || info.sample_range.empty())
     throw InputError(file, "has no prizma:sampleRange: not a prizma-render file that can be resumed");
@@ -149,6 +155,7 @@ ResumePlan plan_resume(const ResumeRequest& req) {
     check("no-majorant-grid", given.no_majorant_grid, o.no_majorant_grid, "the majorant grid");
     check("variance", given.variance, o.variance || !plan.previous.lights.front().variance.empty(),
           "no variance layers");
+    check("features", given.features, o.features || !plan.previous.guides.empty(), "no guide layers");
     o.half = o.half || given.half;
   }
   apply_overrides(plan.scene, o, recorded ? file + ": prizma:renderOptions " : "--");
@@ -158,6 +165,7 @@ ResumePlan plan_resume(const ResumeRequest& req) {
     plan.scene.settings.wavelength_sampling = parse_wavelength_sampling(info.wavelength_sampling, file + ": prizma:wavelengthSampling");
   if (!plan.previous.lights.empty() && !plan.previous.lights.front().variance.empty())
     plan.scene.settings.write_variance = true;
+  if (!plan.previous.guides.empty()) plan.scene.settings.write_guides = true;
 
   // The target: --spp N is the total from the file's first sample; else the recorded target; else
   // (older files) the scene's sample count.

@@ -6,11 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "denoise_test_util.h"
 #include "prizma/denoise/denoise.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/tool_main.h"
 
 namespace prizma::denoise {
 namespace {
@@ -136,6 +138,61 @@ TEST(DenoiseImage, FiltersTheSpectralBasisCoefficientsWithTheSameKernels) {
       EXPECT_EQ(layer.coefficients.values[2 * p + 1], layer.data[p * 8 + 3]) << p;
     }
   }
+}
+
+}  // namespace
+}  // namespace prizma::denoise
+
+namespace prizma::denoise {
+namespace {
+
+// Issue 23 part 2: what was done is recorded (prizma:denoised), a denoised image is not denoised
+// again, and an image's guide layers are the feature planes of its weights.
+TEST(DenoiseImage, RecordsWhatWasDoneAndRefusesToDoItTwice) {
+  const auto img = ramp_image();
+  DenoiseOptions o;
+  o.window_radius_px = 4;
+  o.variance = VarianceOutput::Drop;
+  const auto den = denoise(img, o);
+  const std::string& record = den.info.denoised;  // compact JSON, keys sorted
+  for (const std::string& part : std::vector<std::string>{"\"method\":\"non-local means\"", "\"guides\":[\"luminance\"]", "\"variance\":\"dropped\"",
+                                 "\"window_radius_px\":4", "\"version\":\"" + spectral::prizma_version() + "\""})
+    EXPECT_NE(record.find(part), std::string::npos) << part << " in " << record;
+  EXPECT_TRUE(img.info.denoised.empty());
+  EXPECT_EQ(spectral::denoised_summary(den.info).rfind("denoised by prizma ", 0), 0u) << spectral::denoised_summary(den.info);
+  try {
+    denoise(den, o);
+    FAIL() << "a denoised image was denoised again";
+  } catch (const spectral::InputError& e) {
+    EXPECT_EQ(e.input(), "image");
+    EXPECT_EQ(std::string(e.reason()).rfind("is already denoised (denoised by prizma ", 0), 0u) << e.reason();
+  }
+}
+
+TEST(DenoiseImage, TheImagesGuideLayersAreFeatures) {
+  auto img = ramp_image();
+  spectral::GuideLayer depth{"depth", std::vector<float>(img.pixel_count()), std::vector<float>(img.pixel_count(), 1e-4f)};
+  for (std::size_t p = 0; p < img.pixel_count(); ++p) depth.value[p] = p % 40 < 20 ? 0.2f : 0.8f;  // an edge only it sees
+  img.guides = {depth};
+  const DenoiseGuides g = image_guides(img);
+  ASSERT_EQ(g.features.size(), 1u);
+  EXPECT_EQ(g.features[0].name, "depth");
+  EXPECT_EQ(g.features[0].value, depth.value);
+  const auto den = denoise(img);
+  EXPECT_NE(den.info.denoised.find("\"guides\":[\"luminance\",\"depth\"]"), std::string::npos) << den.info.denoised;
+  // The feature's edge is kept: a pixel beside it takes ≤ 2 % of its weight from across it (as in
+  // FilterWeights.AnEdgeOnlyAFeatureSeesIsKept); without the feature, far more.
+  auto across = [](const FilterWeights& w) {
+    const std::vector<float> k = w.kernel(19, 15);
+    const int r = w.window_radius_px(), n = 2 * r + 1;
+    double sum = 0.0;
+    for (int o = 0; o < n * n; ++o)
+      if (19 + o % n - r >= 20) sum += k[o];
+    return sum;
+  };
+  EXPECT_LE(across(compute_weights(g)), 0.02);
+  EXPECT_GE(across(compute_weights(luminance_guides(img))), 0.2);
+  EXPECT_TRUE(den.guides.empty());  // the denoised image keeps none
 }
 
 }  // namespace

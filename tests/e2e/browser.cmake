@@ -25,6 +25,9 @@ endif()
 if(TARGET prizma-render)
   list(APPEND _live_mri --fluor ${PRIZMA_E2E_WORK}/fluorescence/dye.exr)
   list(APPEND _live_fixtures fluorescence_merged)
+  # A denoised render (tests/e2e/denoise.cmake): its title says so.
+  list(APPEND _live_mri --denoised ${PRIZMA_E2E_WORK}/denoise/clean.exr)
+  list(APPEND _live_fixtures denoise_raw denoise_clean)
 endif()
 foreach(mode server browser)
   add_test(NAME relight.live.${mode}

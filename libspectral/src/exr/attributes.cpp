@@ -110,6 +110,7 @@ void put_attributes(Imf::Header& header, const SpectralImage& image, const std::
   }
   if (!info.scene_path.empty()) header.insert(kAttrScenePath, Imf::StringAttribute(info.scene_path));
   if (!info.render_options.empty()) header.insert(kAttrRenderOptions, Imf::StringAttribute(info.render_options));
+  if (!info.denoised.empty()) header.insert(kAttrDenoised, Imf::StringAttribute(info.denoised));
 }
 
 SpectralExrInfo read_attributes(const Imf::Header& header, const std::string& path) {
@@ -125,6 +126,7 @@ SpectralExrInfo read_attributes(const Imf::Header& header, const std::string& pa
   if (const auto* s = find_string_attr(header, kAttrWavelengthSampling)) info.wavelength_sampling = *s;
   if (const auto* s = find_string_attr(header, kAttrScenePath)) info.scene_path = *s;
   if (const auto* s = find_string_attr(header, kAttrRenderOptions)) info.render_options = *s;
+  if (const auto* s = find_string_attr(header, kAttrDenoised)) info.denoised = *s;
   info.samples = int_attr(header, kAttrSamples, p);
   info.seed = read_seed(header, kAttrSeed, p);
   return info;

@@ -9,6 +9,7 @@
 
 #include "bispectral_exr.h"
 #include "coefficients_exr.h"
+#include "guides_exr.h"
 #include "missing_channels.h"
 #include "prizma/spectral/error.h"
 #include "text_util.h"
@@ -91,6 +92,7 @@ void verify_checksum(const std::string& p, const Imf::Header& header, const std:
     if (top != nullptr) sum += layer_hash(LayerKind::Sum, top->data(), top->size());
     sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
     sum += detail::coefficients_checksum(image);  // 0 without spectral-basis coefficients
+    sum += detail::guides_checksum(image);        // 0 without guide layers
     expected = checksum_string(sum);
   } else if (stored.rfind(kChecksumSchemeV1, 0) == 0) {
     expected = checksum_string(light_layers_hash(image), kChecksumSchemeV1);
@@ -128,6 +130,7 @@ std::string spectral_pixel_checksum(const SpectralImage& image) {
   }
   sum += detail::reradiation_checksum(image);  // 0 without bispectral terms
   sum += detail::coefficients_checksum(image);  // 0 without spectral-basis coefficients
+  sum += detail::guides_checksum(image);        // 0 without guide layers
   return exr::checksum_string(sum);
 }
 

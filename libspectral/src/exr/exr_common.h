@@ -31,6 +31,7 @@ inline constexpr const char* kAttrWavelengthSampling = "prizma:wavelengthSamplin
 inline constexpr const char* kAttrChecksum = "prizma:checksum";
 inline constexpr const char* kAttrScenePath = "prizma:scenePath";
 inline constexpr const char* kAttrRenderOptions = "prizma:renderOptions";
+inline constexpr const char* kAttrDenoised = "prizma:denoised";
 inline constexpr const char* kVarianceLayer = "var";
 inline constexpr float kHalfMax = 65504.0f;
 
@@ -45,6 +46,8 @@ enum class LayerKind : unsigned char {
   Bispectral,    // a light's re-radiation pairs M[out][in] ([<light>.]T.<λin>nm.<λout>nm; bispectral.cpp)
   Coefficients,  // a light's spectral-basis coefficients ([<light>.]coef.<j>; coefficients_exr.cpp)
   Basis,         // the basis vectors of those coefficients (prizma:basis.<light>)
+  Guide,         // a guide plane of the denoiser (guide.<name>; guides_exr.cpp)
+  GuideVariance, // its variance of the mean (guide.<name>.var)
   Preview,       // R, G, B: the default relight in linear sRGB, derived, outside the checksum
 };
 struct LayerKindInfo {
@@ -59,6 +62,8 @@ inline constexpr LayerKindInfo kLayerKinds[] = {
     {LayerKind::Bispectral, "bispectral terms of light", 0x2325cbf29ce48422ULL},
     {LayerKind::Coefficients, "coefficients of light", 0x9ce484222325cbf2ULL},
     {LayerKind::Basis, "basis of light", 0x484222325cbf29ceULL},
+    {LayerKind::Guide, "guide", 0x2223cbf29ce48425ULL},
+    {LayerKind::GuideVariance, "variance of guide", 0xf29ce4842223cb25ULL},
     {LayerKind::Preview, "preview", 0},
 };
 constexpr const LayerKindInfo& layer_kind(LayerKind k) {

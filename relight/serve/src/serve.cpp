@@ -225,6 +225,9 @@ struct RelightServer::Impl {
                 {"displaySpaces", spaces},
                 {"observers", {"1931", "1964", "2012-2", "2012-10"}},
                 {"spectra", spectral::named_illuminants()}};
+    // A denoised file says so in the page's title (null: the raw Monte Carlo means).
+    const std::string denoised = spectral::denoised_summary(img.info);
+    out["denoised"] = denoised.empty() ? json(nullptr) : json(denoised);
     out.update(transport.describe());
     return out;
   }

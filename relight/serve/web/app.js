@@ -356,7 +356,8 @@ async function main() {
     info = await api('/api/info');
     const what = info.source + ' — ' + info.width + '×' + info.height + ', ' + (info.bins.length - 1) + ' bins ' +
                  info.bins[0] + '–' + info.bins[info.bins.length - 1] + ' nm, lights ' +
-                 info.lights.map((l) => l.name).join(', ');
+                 info.lights.map((l) => l.name).join(', ') + (info.denoised ? ' — ' + info.denoised : '');
+    if (info.denoised) document.title += ' (denoised)';
     $('title').textContent = what;
     $('transport').textContent = describeTransport();
     buildLightControls();

@@ -214,6 +214,8 @@ class Shell {
     std::ostringstream o;
     o << "file        " << m_session.source() << " (" << img.width << "×" << img.height << ", " << img.bins.size()
       << " bins " << img.bins.min_nm() << "–" << img.bins.max_nm() << " nm)\n";
+    if (const std::string denoised = spectral::denoised_summary(img.info); !denoised.empty())
+      o << "filter      " << denoised << "\n";
     for (std::size_t l = 0; l < s.lights.size(); ++l) {
       o << "light       " << m_session.light_names()[l] << " = " << s.lights[l].text << " (default "
         << m_session.default_lights()[l].text << ")\n";

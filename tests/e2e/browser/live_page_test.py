@@ -164,7 +164,7 @@ def check_excitation_emission_map(browser, srv, exr):
               "map of light %s: the largest pair (%d → %d, %.4g) drawn in the top colour (%r)" % (light, i, o, v, rgb))
 
 
-def test_browser(relight, workdir, mri=None, fluor=None):
+def test_browser(relight, workdir, mri=None, fluor=None, denoised=None):
     chromium = shutil.which("chromium")
     driver_path = shutil.which("chromedriver") or ("/usr/bin/chromedriver" if os.path.exists("/usr/bin/chromedriver") else None)
     try:
@@ -187,6 +187,8 @@ def test_browser(relight, workdir, mri=None, fluor=None):
         browser = webdriver.Chrome(service=Service(driver_path), options=opts)
         try:
             check_pages(browser, relight, workdir, mri, fluor)
+            if denoised:
+                check_denoised_title(browser, relight, workdir, denoised)
             from cross_site import check_cross_site
             check_cross_site(browser, relight, workdir)
         finally:
@@ -391,6 +393,26 @@ return {view: [window.innerWidth, window.innerHeight], dpr: window.devicePixelRa
         rendering: getComputedStyle(c).imageRendering};"""
 
 
+TITLES = "return [document.getElementById('title').textContent, document.title];"
+
+
+def check_denoised_title(browser, relight, workdir, denoised):
+    """Issue 23: a denoised file says so in the page's title line and the tab's title; a raw file
+    does not (the check can fail)."""
+    for exr, is_denoised in ((denoised, True), (os.path.join(workdir, "two.exr"), False)):
+        srv = Server(relight, exr, workdir)
+        try:
+            browser.get(srv.url)
+            wait_for(browser, DRAWN, lambda r: r[2] >= 1 or r[1])
+            line, tab = wait_for(browser, TITLES, lambda t: "(prizma " in t[0])
+            says = "denoised by prizma" in line and "non-local means on luminance" in line and tab.endswith("(denoised)")
+            quiet = "denoised" not in line and "denoised" not in tab
+            check(says if is_denoised else quiet, "%s: the title line %r and the tab's %r %s" % (
+                os.path.basename(exr), line, tab, "say it is denoised" if is_denoised else "say nothing of denoising"))
+        finally:
+            check(srv.stop() == 0, "server for %s stopped cleanly" % srv.url)
+
+
 def check_layout(browser, srv, name):
     """Issue 25 item 2: in a browser window of 1400×900 (a laptop screen; headless Chromium leaves a
     1400×757 page inside it, as a browser with its tab and address bars does) and of 1920×1080, the
@@ -485,7 +507,7 @@ def save_from_page(browser, workdir, name):
 
 def main():
     args = sys.argv[1:]
-    mri = fluor = None
+    mri = fluor = denoised = None
     if "--mri" in args:
         i = args.index("--mri")
         mri = os.path.abspath(args[i + 1])
@@ -493,6 +515,10 @@ def main():
     if "--fluor" in args:
         i = args.index("--fluor")
         fluor = os.path.abspath(args[i + 1])
+        del args[i:i + 2]
+    if "--denoised" in args:
+        i = args.index("--denoised")
+        denoised = os.path.abspath(args[i + 1])
         del args[i:i + 2]
     if len(args) != 3 or args[0] not in ("server", "browser"):
         print(__doc__)
@@ -502,7 +528,7 @@ def main():
         from server_checks import test_server
         rc = test_server(relight, workdir)
     else:
-        rc = test_browser(relight, workdir, mri, fluor)
+        rc = test_browser(relight, workdir, mri, fluor, denoised)
     if failures:
         print("%d check(s) failed" % len(failures))
         return 1

@@ -16,7 +16,7 @@ import subprocess
 import sys
 import time
 
-TOOLS = {"prizma-render": ["merge", "inspect"], "prizma-relight": ["compress"],
+TOOLS = {"prizma-render": ["merge", "inspect", "denoise"], "prizma-relight": ["compress"],
          "prizma-metamer": ["metamer", "light", "delta-e", "weights", "tabulate"]}
 failures = []
 

@@ -31,13 +31,23 @@ struct DenoiseGuides {
 // The white-light luminance guide of a spectral image: per pixel Y = Σ_lights Σ_bins ȳ_i·T_l,i, with
 // ȳ_i the CIE 1931 ȳ integrated over bin i under an equal-energy light normalised so that a perfect
 // white under one light has Y = 1 (spectral::relight_weights), plus the bispectral terms' Y under
-// that light. Every light layer (the emission layer too) counts. Its variance is the fully
+// that light (require_raw_image first). Every light layer (the emission layer too) counts. Its variance is the fully
 // correlated bound (Σ_l Σ_i ȳ_i·σ_l,i)²: one path estimates every bin of every light, so the bins'
 // errors are strongly positively correlated (exact when they move together; at most bins×lights
 // times the true variance when they are independent). Bispectral terms carry no variance layer and
 // add none. Throws InputError (input "image") when a layer has no variance layer (render with
 // --variance), for a compact file (coefficients only), or for non-finite values.
 DenoiseGuides luminance_guides(const spectral::SpectralImage& image);
+
+// luminance_guides(image) with the image's guide layers (SpectralImage::guides: prizma-render
+// --features) as feature planes, named after them: the guides of a rendered file. Throws as
+// luminance_guides.
+DenoiseGuides image_guides(const spectral::SpectralImage& image);
+
+// Throws InputError (input "image") for an image that is already denoised (info.denoised set):
+// its pixels are no longer independent means, so the noise the weights compare against is unknown.
+// luminance_guides and denoise() call it first.
+void require_raw_image(const spectral::SpectralImage& image);
 
 // Checks the planes' sizes against width × height and that every value and variance is finite and
 // every variance ≥ 0; the luminance must have a variance plane. Throws InputError naming the plane.

@@ -7,6 +7,7 @@
 // computed tile by tile where they are applied (denoise.h) and for one pixel by kernel(); every
 // pixel's kernel is the same number for number however the image is tiled or threaded.
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "prizma/denoise/denoise_guides.h"
@@ -37,6 +38,9 @@ class FilterWeights {
   // neighbours outside the image, summing to 1 (to float rounding). Throws std::out_of_range for a
   // pixel outside the image.
   std::vector<float> kernel(int x, int y) const;
+
+  // The guides the kernels are computed from, by name: "luminance", then each feature's, in order.
+  std::vector<std::string> guide_names() const;
 
   // The kernels of every pixel of `rect` (inside the image), offset-major:
   // out[o·rect.pixel_count() + (y − y0)·rect.width + (x − x0)] is weight o of pixel (x, y), offsets

@@ -26,6 +26,9 @@ struct SpectralExrInfo {
   std::string wavelength_sampling;  // prizma:wavelengthSampling
   std::string scene_path;        // prizma:scenePath, the scene file (absolute) the render read
   std::string render_options;    // prizma:renderOptions (JSON object: the command-line overrides)
+  // prizma:denoised (JSON object: method, parameters, guides, variance, version; docs/denoise.md), or
+  // empty: the values are the raw Monte Carlo means. denoised_summary() says it in words.
+  std::string denoised;
   bool is_prizma = false;        // read: the file carried prizma: attributes
   // Read: what the reader inferred or adjusted that a careful user may want to know (an inferred bin
   // edge clamped to the colour matching tables); the tools print these with -v. Never written.
@@ -65,6 +68,15 @@ struct TransportLayer {
   LayerCoefficients coefficients;
 };
 
+// A light-independent per-pixel plane the renderer writes for the denoiser (prizma-render --features;
+// docs/spectral-exr.md, "Guide layers"): channels guide.<name> and guide.<name>.var.
+struct GuideLayer {
+  std::string name;              // letters, digits and '_': "depth", "scatter"
+  std::vector<float> value;      // width·height floats, row-major: the per-pixel Monte Carlo mean
+  std::vector<float> variance;   // empty or same size: its variance of the mean
+  bool operator==(const GuideLayer&) const = default;
+};
+
 // A bispectral term: light absorbed in bin `in` re-emitted into bin `out` (in ≠ out).
 struct BinPair {
   int in = 0;
@@ -81,6 +93,9 @@ struct SpectralImage {
   // The bispectral pairs every light's `reradiation` holds, sorted by (in, out); empty for a
   // wavelength-diagonal image (no fluorescence), which is then written exactly as before.
   std::vector<BinPair> reradiation;
+
+  // Guide layers (renders with --features), in the order written; empty for most files.
+  std::vector<GuideLayer> guides;
 
   // How the layers' coefficients were chosen (prizma:coefficients "criterion", a JSON object), or empty.
   std::string coefficient_criterion;
@@ -150,6 +165,11 @@ SpectralImage read_spectral_exr(const std::filesystem::path& path, const ExrRead
 // layer (docs/spectral-exr.md gives the definition). A float file's stored checksum equals this for
 // the image read from it (a half file's holds the sum rounded to half).
 std::string spectral_pixel_checksum(const SpectralImage& image);
+
+// What prizma:denoised records, as the readers show it ("denoised by prizma 0.5: non-local means on
+// luminance, depth; variance propagated"), or "" for a raw file. Never throws: a record it cannot
+// parse is shown as "denoised (prizma:denoised unreadable)".
+std::string denoised_summary(const SpectralExrInfo& info);
 
 // "T.550,000000nm" style channel name for a wavelength (six decimals, comma separator).
 std::string spectral_channel_name(double lambda_nm, std::string_view layer = "");

@@ -112,6 +112,10 @@ struct PathResult {
   // moves it here as one record of fl_segment_size(lights) floats, {λin, environment, emission,
   // directional[0..lights)}, and fl_<light> restart at zero (docs/fluorescence.md).
   std::vector<float> fl_segments;
+  // Guide data (light-independent; prizma-render --features): whether the path scattered at all and
+  // the distance from the volume's bounds to its first scattering along the camera ray.
+  bool scattered = false;
+  float first_scatter_depth = 0.0f;
   static constexpr std::size_t kSegmentLambda = 0, kSegmentEnvironment = 1, kSegmentEmission = 2,
                                kSegmentDirectional = 3;
   static std::size_t fl_segment_size(std::size_t directional_lights) { return kSegmentDirectional + directional_lights; }

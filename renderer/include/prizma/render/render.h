@@ -63,13 +63,17 @@ spectral::SpectralImage render_folded(const Scene& scene, const RenderCallbacks&
 
 // Combines renders of disjoint sample ranges of the same scene into the render of their union
 // (weighted by sample counts; variance layers combined when all shards carry them). Throws
-// InputError for an empty list, different scene hash, seed, bins, size, lights or wavelength
+// InputError for an empty list, a denoised shard, different scene hash, seed, bins, size, lights or wavelength
 // sampling, or overlapping sample ranges, naming the shard by names[k] (its file) where given, else
 // "shard k". Ranges need not be contiguous; the result's sampleRange is "min:max" when they are and
 // lists them ("0:8,16:24") otherwise. prizma:renderOptions: the shards' common options with the
 // union as target range (empty when the shards' options differ).
 spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards,
                                      const std::vector<std::string>& names = {});
+
+// Throws InputError(name, …) when `image` is denoised (prizma:denoised): samples cannot be added to
+// filtered values (merge_shards and --resume refuse it; merge the raw renders, then denoise).
+void require_raw_samples(const spectral::SpectralImage& image, const std::string& name);
 
 // The scene's lights as the records stored in prizma:lights.
 std::vector<spectral::LightRecord> light_records(const std::vector<Light>& lights);

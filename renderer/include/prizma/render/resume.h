@@ -24,6 +24,7 @@ struct RenderOverrides {
   std::optional<double> target_error;
   bool no_majorant_grid = false;
   bool variance = false;
+  bool features = false;  // --features (guide layers); "features" in prizma:renderOptions
   bool half = false;
   // The whole sample range asked for (--samples A:B, or --spp N from the scene's first sample, or
   // the scene's "samples"); an interrupted file holds a prefix of it.

@@ -144,6 +144,7 @@ struct RenderSettings {
   bool use_majorant_grid = true;
   int threads = 0;                    // 0 = all cores
   bool write_variance = false;
+  bool write_guides = false;          // --features: guide layers for the denoiser (film.h)
 };
 
 struct Scene {
