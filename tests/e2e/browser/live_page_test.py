@@ -423,7 +423,10 @@ def check_layout(browser, srv, name):
     wait_for(browser, DRAWN, lambda r: r[2] >= 1 or r[1])
     for width, height in ((1400, 900), (1920, 1080)):
         browser.set_window_size(width, height)
-        wait_for(browser, "return [window.outerWidth, window.outerHeight];", lambda g: g == [width, height])
+        # The page's viewport follows the window a moment later (headless Chromium resizes it
+        # asynchronously): wait for both.
+        wait_for(browser, "return [window.outerWidth, window.outerHeight, window.innerWidth];",
+                 lambda g: g == [width, height, width])
         lay = wait_for(browser, "return (" + "() => {" + LAYOUT + "})();",
                        lambda l: (l["zoom"] or 0) >= 1 and (l["zoom"] + 1) * max(l["size"][0] / max(l["box"][0], 1),
                                                                            l["size"][1] / max(l["box"][1], 1)) > l["dpr"])
