@@ -45,6 +45,9 @@ endforeach()
 
 # The tools' --help examples, man pages and bash completion on the installed tree, through man and a
 # real bash in tmux (tests/e2e/docs/check_help.py).
+# (help2man is also looked for here: cmake/PrizmaToolDocs.cmake may be read after this file, and on a
+# fresh configure the test would otherwise be registered as missing its tool.)
+find_program(PRIZMA_HELP2MAN help2man)
 find_program(PRIZMA_TMUX tmux)
 find_program(PRIZMA_MAN man)
 if(PRIZMA_HELP2MAN AND PRIZMA_TMUX AND PRIZMA_MAN)
