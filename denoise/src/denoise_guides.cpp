@@ -70,8 +70,10 @@ DenoiseGuides luminance_guides(const spectral::SpectralImage& image) {
   spectral::LightSpectrum white;
   white.text = "E";
   white.spectrum = spectral::Spectrum::constant(1.0);
-  const Eigen::VectorXd ypair = spectral::reradiation_pair_xyz(image, cmf, white).row(1).transpose();
   const std::size_t np = image.reradiation.size();
+  // (A 3×0 matrix has no storage: taking its row would offset a null pointer, so only with pairs.)
+  Eigen::VectorXd ypair;
+  if (np > 0) ypair = spectral::reradiation_pair_xyz(image, cmf, white).row(1).transpose();
 
   DenoiseGuides g;
   g.width = image.width;
