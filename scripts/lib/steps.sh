@@ -63,7 +63,7 @@ prizma_build_installed() {
     tail -n 40 "$build/build.log" >&2
     exit 1
   fi
-  echo "  built: $build/renderer/prizma-render, $build/relight/prizma-relight, $build/libspectral/prizma-metamer" >&2
+  echo "  built: $build/renderer/prizma-render, $build/relight/prizma-relight, $build/metamer/prizma-metamer" >&2
 }
 
 # prizma_install BUILD PREFIX: cmake --install, quietly, stripped (the build folder keeps the debug
