@@ -31,7 +31,7 @@ prizma_denoise_e2e(raw_features1 ${_render} "${_tiny}|--variance|--features|--sa
 
 function(prizma_denoise_case name exe args)
   prizma_denoise_e2e(${name} ${exe} "${args}" ${ARGN})
-  set_tests_properties(denoise.e2e.${name} PROPERTIES FIXTURES_REQUIRED denoise_raw)
+  set_property(TEST denoise.e2e.${name} APPEND PROPERTY FIXTURES_REQUIRED denoise_raw)  # (beside the case's own)
 endfunction()
 prizma_denoise_case(help ${_render} "denoise|--help" OUT_REGEX "--variance.*propagate.*drop")
 prizma_denoise_case(denoise ${_render} "denoise|raw.exr|-o|clean.exr|--threads|2" MUST_EXIST clean.exr
