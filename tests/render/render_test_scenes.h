@@ -141,4 +141,26 @@ inline BinEstimate pixel_average(const spectral::SpectralImage& img, int light) 
   return e;
 }
 
+// Bin average over [lo, hi] of e^{−D σ(λ)} for σ linear in λ: (e^{−D σ(lo)} − e^{−D σ(hi)}) / (D (σ(hi) − σ(lo))).
+inline double bin_transmittance(double sigma_lo, double sigma_hi, double depth) {
+  const double a = depth * sigma_lo, b = depth * sigma_hi;
+  return std::abs(b - a) < 1e-12 ? std::exp(-a) : (std::exp(-a) - std::exp(-b)) / (b - a);
+}
+
+// The window [−0.4, 0.4]² of a 4³ box_scene seen from above, over its columns [−0.5 + k/4,
+// −0.25 + k/4] (widths 0.15, 0.25, 0.25, 0.15): Σ over the columns of their area fraction times
+// f(D), D = the column's mean density.
+template <class F>
+double column_window_average(const Scene& s, F f) {
+  const double width[4] = {0.15, 0.25, 0.25, 0.15};
+  double sum = 0.0;
+  for (int cy = 0; cy < 4; ++cy)
+    for (int cx = 0; cx < 4; ++cx) {
+      double depth = 0.0;
+      for (int cz = 0; cz < 4; ++cz) depth += s.medium.density[(static_cast<std::size_t>(cz) * 4 + cy) * 4 + cx] / 4.0;
+      sum += width[cx] * width[cy] / 0.64 * f(depth);
+    }
+  return sum;
+}
+
 }  // namespace prizma::render::testing

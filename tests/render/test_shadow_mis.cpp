@@ -151,10 +151,6 @@ TEST(ShadowMis, SingleScatteringThroughAHeterogeneousChromaticSlabPerBin) {
   // the grid, with one global cell, and with two materials of the same spectra in alternate voxels
   // (cells without a control: every lane at the cell's majorant).
   const double s400 = 0.05, s700 = 5.0, w = 0.7, g = 0.3;
-  auto bin_transmittance = [](double lo, double hi, double depth) {
-    const double a = depth * lo, b = depth * hi;
-    return (std::exp(-a) - std::exp(-b)) / (b - a);
-  };
   for (int variant = 0; variant < 3; ++variant) {
     const Material mat =
         testing::make_material(Spectrum::constant(w), Spectrum({400.0, 700.0}, {s400, s700}), Spectrum::constant(g));
@@ -172,16 +168,11 @@ TEST(ShadowMis, SingleScatteringThroughAHeterogeneousChromaticSlabPerBin) {
     RenderStats stats;
     const auto m = testing::pixel_average(render(s, {}, &stats), 0);
     EXPECT_GT(stats.shadow_steps, 0) << "variant " << variant;
-    const double width[4] = {0.15, 0.25, 0.25, 0.15};
     for (int b = 0; b < 6; ++b) {
       const double lo = s400 + (s700 - s400) * b / 6.0, hi = s400 + (s700 - s400) * (b + 1) / 6.0;
-      double expected = 0.0;
-      for (int cy = 0; cy < 4; ++cy)
-        for (int cx = 0; cx < 4; ++cx) {
-          double depth = 0.0;
-          for (int cz = 0; cz < 4; ++cz) depth += s.medium.density[(static_cast<std::size_t>(cz) * 4 + cy) * 4 + cx] / 4.0;
-          expected += width[cx] * width[cy] / 0.64 * w * testing::hg(-1.0, g) * (1.0 - bin_transmittance(lo, hi, 2.0 * depth)) / 2.0;
-        }
+      const double expected = testing::column_window_average(s, [&](double depth) {
+        return w * testing::hg(-1.0, g) * (1.0 - testing::bin_transmittance(lo, hi, 2.0 * depth)) / 2.0;
+      });
       EXPECT_NEAR(m.mean[b], expected, kSe * m.se[b]) << "variant " << variant << " bin " << b << ": " << m.mean[b]
                                                       << " ± " << m.se[b] << ", expected " << expected;
       EXPECT_LT(m.se[b], 0.03 * expected) << "variant " << variant << " bin " << b;
