@@ -15,6 +15,7 @@
 
 #include "kernel_simd.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/large_buffer.h"
 #include "prizma/spectral/tool_main.h"
 
 namespace prizma::denoise {
@@ -110,12 +111,14 @@ spectral::SpectralImage denoise(const spectral::SpectralImage& image, const Filt
   out.reradiation = image.reradiation;
   out.coefficient_criterion = image.coefficient_criterion;
   // Every per-pixel plane of every layer, each into its own output of the same size.
-  std::vector<detail::ApplyPlane> planes;
-  const std::size_t pixels = image.pixel_count();
+  struct Pending {
+    const std::vector<float>* in;
+    std::vector<float>* out;
+    bool squared;
+  };
+  std::vector<Pending> pending;
   auto add = [&](const std::vector<float>& in, std::vector<float>& dst, bool squared) {
-    if (in.empty()) return;
-    dst.resize(in.size());
-    planes.push_back({in.data(), dst.data(), static_cast<int>(in.size() / pixels), squared});
+    if (!in.empty()) pending.push_back({&in, &dst, squared});
   };
   out.lights.resize(image.lights.size());
   for (std::size_t l = 0; l < image.lights.size(); ++l) {
@@ -129,6 +132,14 @@ spectral::SpectralImage denoise(const spectral::SpectralImage& image, const Filt
     dst.coefficients.basis = src.coefficients.basis;
     add(src.coefficients.values, dst.coefficients.values, false);
   }
+  // The outputs are allocated (zeroed, their pages first touched) a plane per task, in huge pages
+  // where offered (large_buffer.h): from one thread in 4 KB pages, this took a third of the time.
+  tbb::parallel_for(std::size_t{0}, pending.size(),
+                    [&](std::size_t i) { spectral::allocate_zeroed(*pending[i].out, pending[i].in->size()); });
+  const std::size_t pixels = image.pixel_count();
+  std::vector<detail::ApplyPlane> planes;
+  for (const Pending& p : pending)
+    planes.push_back({p.in->data(), p.out->data(), static_cast<int>(p.in->size() / pixels), p.squared});
   apply_planes(weights, planes);
   return out;
 }

@@ -26,6 +26,7 @@
 #include "exr/header_guard.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
+#include "prizma/spectral/large_buffer.h"
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/tool_main.h"
 #include "text_util.h"
@@ -312,10 +313,10 @@ void read_pixels(Imf::InputFile& file, const ChannelSets& sets, const std::vecto
   }
   for (std::size_t k = 0; k < sources.size() && !sets.compact; ++k) {
     TransportLayer& light = image.lights[k];
-    light.data.assign(count, 0.0f);
+    allocate_zeroed(light.data, count);
     add_slices(fb, sets.layers.at(sources[k].layer), light.data, dw, n);
     if (!sources[k].variance.empty()) {
-      light.variance.assign(count, 0.0f);
+      allocate_zeroed(light.variance, count);
       add_slices(fb, sets.layers.at(sources[k].variance), light.variance, dw, n);
     }
   }
@@ -332,7 +333,7 @@ void read_pixels(Imf::InputFile& file, const ChannelSets& sets, const std::vecto
   std::vector<float> top;
   const bool read_top = stored != nullptr && stored->rfind(exr::kChecksumScheme, 0) == 0 && named && sets.layers.count("") != 0;
   if (read_top) {
-    top.assign(count, 0.0f);
+    allocate_zeroed(top, count);
     add_slices(fb, sets.layers.at(""), top, dw, n);
   }
   file.setFrameBuffer(fb);
