@@ -76,6 +76,7 @@ void OffsetWeights(const OffsetJob& j) {
     }
   }
   const V inv_area = hn::Set(d, j.inv_patch_area), ct2 = hn::Set(d, j.centre_t2);
+  const auto neighbour = hn::Ne(hn::Set(d, static_cast<float>(j.dx != 0 || j.dy != 0)), zero);  // all lanes
   for (int y = 0; y < j.tile_h; ++y) {
     const std::ptrdiff_t centre_row = static_cast<std::ptrdiff_t>(y + r + f) * j.lum_stride + r + f;
     const std::ptrdiff_t neighbour_row = static_cast<std::ptrdiff_t>(y + r + f + j.dy) * j.lum_stride + r + f + j.dx;
@@ -102,9 +103,12 @@ void OffsetWeights(const OffsetJob& j) {
         const V num = hn::Sub(hn::Mul(diff, diff), hn::Add(vp, hn::Min(vp, vq)));
         feature = hn::Max(feature, hn::Div(num, hn::LoadU(d, ft.denominator + t)));
       }
+      // A centre of zero variance is exact (every sample the same: rays that all missed the volume),
+      // so it keeps its own value: no neighbour may pull a noise-free background toward a noisy edge.
+      const auto exact = hn::And(hn::Eq(hn::LoadU(d, j.lum_var + centre_row + x), zero), neighbour);
       for (int c = 0; c < j.candidates; ++c) {
         const V colour = hn::Add(hn::Max(zero, hn::Mul(mean_d2, hn::LoadU(d, j.inv_k2[c] + t))), shared);
-        hn::StoreU(ExpNegative(d, hn::Max(colour, feature)), d, j.weights[c] + t);
+        hn::StoreU(hn::IfThenZeroElse(exact, ExpNegative(d, hn::Max(colour, feature))), d, j.weights[c] + t);
       }
     }
   }

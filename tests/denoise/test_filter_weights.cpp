@@ -53,6 +53,25 @@ TEST(FilterWeights, AConstantImageStaysConstant) {
   for (float v : out) ASSERT_NEAR(v, 0.75f, 0.75f * 1.4e-5f);
 }
 
+TEST(FilterWeights, AZeroVariancePixelKeepsItsOwnValue) {
+  // A noise-free background (every sample 0, variance 0) beside a faint, very noisy medium
+  // (relative noise 1, so the centre test cannot cut it): the background keeps exactly 0 up to the
+  // edge, and the medium is still averaged.
+  auto g = test::noisy_guides(kW, kH, 0.3f, 11, [](int x, int) { return x < 32 ? 0.0 : 0.3; });
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < 32; ++x) {
+      g.luminance.value[static_cast<std::size_t>(y) * kW + x] = 0.0f;
+      g.luminance.variance[static_cast<std::size_t>(y) * kW + x] = 0.0f;
+    }
+  const FilterWeights w = compute_weights(g);
+  const std::vector<float> out = apply(w, g.luminance.value, 1);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < 32; ++x) ASSERT_EQ(out[static_cast<std::size_t>(y) * kW + x], 0.0f) << x << "," << y;
+  const int r = w.window_radius_px(), n = 2 * r + 1;
+  EXPECT_EQ(w.kernel(31, 20)[static_cast<std::size_t>(r * n + r)], 1.0f);   // the edge's background pixel
+  EXPECT_LT(w.kernel(40, 20)[static_cast<std::size_t>(r * n + r)], 0.5f);   // the medium: averaged
+}
+
 // Mean over the rows of (filtered − truth) in column x.
 double column_bias(const std::vector<float>& out, int x, double truth) {
   double s = 0.0;
