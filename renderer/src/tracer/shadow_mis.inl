@@ -94,8 +94,15 @@ void PathTracer::transmittance_mis(const Eigen::Vector3d& origin, const Eigen::V
       return false;
     }
     const float inv = rho_total / mix;
-    T *= a * inv;
-    P *= b * inv;
+    // T *= a·inv and P *= b·inv in one pass (the same bits; T, P, a, b are four scratch rows).
+    float* __restrict pt = T.data();
+    float* __restrict pp = P.data();
+    const float* __restrict pa = a.data();
+    const float* __restrict pb = b.data();
+    for (int i = 0; i < n; ++i) {
+      pt[i] *= pa[i] * inv;
+      pp[i] *= pb[i] * inv;
+    }
     return true;
   };
   auto on_segment = [&](const MajorantTraversal::Segment& seg, float& mu) {

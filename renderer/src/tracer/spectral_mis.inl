@@ -18,15 +18,59 @@
 
 namespace prizma::render {
 
+namespace mis_detail {
+
+// Σ x[i] and Σ y[i] in one pass, each in partial::sum's order: the same bits as partial::sum(x, n)
+// and partial::sum(y, n).
+template <class X, class Y>
+void sum2(const X& x, const Y& y, int n, float& sx, float& sy) {
+  constexpr int kW = partial::kWidth;
+  float px[kW] = {}, py[kW] = {};
+  int i = 0;
+  for (; i + kW <= n; i += kW)
+    for (int k = 0; k < kW; ++k) {
+      px[k] += x[i + k];
+      py[k] += y[i + k];
+    }
+  for (int k = 0; i < n; ++i, ++k) {
+    px[k] += x[i];
+    py[k] += y[i];
+  }
+  sx = 0.0f;
+  for (int k = 0; k < kW; ++k) sx += px[k];
+  sy = 0.0f;
+  for (int k = 0; k < kW; ++k) sy += py[k];
+}
+
+// collision_lanes (event_probability.h) with a majorant per lane, lane k's own μ̄_k. The pointers are
+// __restrict so that GCC vectorises the loop: with six plain pointers it needs more alias checks than
+// it versions a loop for, and the loop over Lanes views it replaces stayed scalar.
+inline void collision_lanes_per_lane(int n, float density, const float* __restrict mu,
+                                     const float* __restrict sigma_t, const float* __restrict albedo,
+                                     float* __restrict sa, float* __restrict ss, float* __restrict sn) {
+  for (int i = 0; i < n; ++i) collision_lane(density, mu[i], sigma_t[i], albedo[i], sa[i], ss[i], sn[i]);
+}
+
+}  // namespace mis_detail
+
 bool PathTracer::mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) const {
   const int n = v.n;
   const Lanes<0>& rho = v.mix;
-  const float total = partial::sum(rho, n);
-  const float mix = partial::sum(rho * b, n);
+  // Σ ρ and Σ ρ b in one pass, w and ρ in another (the same bits as two partial::sum calls and
+  // `w *= a * inv; ρ *= b * inv`, in half the passes over the lanes). a and b are scratch rows, never
+  // w or ρ (they may be the same row as each other: both are only read).
+  float total, mix;
+  mis_detail::sum2(rho.view(), rho * b, n, total, mix);
   if (!(mix > 0.0f) || !(total > 0.0f) || !std::isfinite(mix)) return false;  // no lane can go on
   const float inv = total / mix;  // 1 / S
-  v.w *= a * inv;
-  rho *= b * inv;
+  float* __restrict pw = v.w.data();
+  float* __restrict pr = rho.data();
+  const float* __restrict pa = a.data();
+  const float* __restrict pb = b.data();
+  for (int i = 0; i < n; ++i) {
+    pw[i] *= pa[i] * inv;
+    pr[i] *= pb[i] * inv;
+  }
   return true;
 }
 
@@ -64,6 +108,7 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
   };
   CellSpectralBound cell;  // the current cell's bound
   bool in_cell = false;
+  bool rate_set = false;  // rate holds the current cell's μ̄_k (set at its first collision)
   double cell_t1 = 0.0, t_from = 0.0;  // the cell's end; where its not yet counted part starts
   auto count_to = [&](double t) {
     if (in_cell && cell.material != CellSpectralBound::kNone) {
@@ -90,6 +135,7 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
   auto on_segment = [&](const MajorantTraversal::Segment& seg, float& mu) {
     count_to(cell_t1);
     in_cell = false;
+    rate_set = false;
     if (!(seg.majorant > 0.0f)) return true;  // empty cell: no collisions, no depth in any lane
     cell = m_grid.spectral_bound(seg.cell);
     if (cell.material != CellSpectralBound::kNone) {
@@ -114,10 +160,15 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
     }
     count_to(tc.t);
     transmittance_ratios();
-    if (cell.material != CellSpectralBound::kNone)
-      rate = sigma_t_of(cell.material) * cell.density_max;
-    else
-      rate = tc.mu;
+    // The lanes' majorants, once per cell (the light estimates, which borrow the buffer, run only
+    // between free flights).
+    if (!rate_set) {
+      if (cell.material != CellSpectralBound::kNone)
+        rate = sigma_t_of(cell.material) * cell.density_max;
+      else
+        rate = tc.mu;
+      rate_set = true;
+    }
     return collide_mis(v, tc, end, rng, s);
   });
   if (!reached) return end;
@@ -152,11 +203,10 @@ bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, Flig
     return true;
   }
   if (!cache.holds(m)) evaluate_material(m, s);
-  {  // σn,k = μ̄_k − σt,k with the lane's own majorant
-    const float* st = cache.sigma_t.data() + static_cast<std::size_t>(m) * n;
-    const float* al = cache.albedo.data() + static_cast<std::size_t>(m) * n;
-    for (int k = 0; k < n; ++k) collision_lane(d, rate[k], st[k], al[k], sa[k], ss[k], sn[k]);
-  }
+  // σn,k = μ̄_k − σt,k with the lane's own majorant
+  mis_detail::collision_lanes_per_lane(n, d, rate.data(), cache.sigma_t.data() + static_cast<std::size_t>(m) * n,
+                                       cache.albedo.data() + static_cast<std::size_t>(m) * n, sa.data(), ss.data(),
+                                       sn.data());
   if (m_emits[m]) {
     // Emission at every tentative collision (pbrt-v4's estimator): lane i's ∫ T_i σa,i Le,i ds
     // sampled at density Σ_k c_k p_k μ̄_k T_k.
@@ -188,9 +238,18 @@ bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, Flig
     const Lanes<0>& coef = scatter ? ss : sn;
     a = ratio * coef;
     const float none = scatter ? 1.0f : 0.0f;
-    for (int k = 0; k < n; ++k) {
-      const float ck = ss[k] + sn[k];
-      b[k] = ratio[k] * rate[k] * (ck > 0.0f ? coef[k] / ck : none);
+    {  // (restrict pointers and a division by 1 where ck is 0, so that the loop vectorises)
+      const float* __restrict pr = ratio.data();
+      const float* __restrict pm = rate.data();
+      const float* __restrict pc = coef.data();
+      const float* __restrict pss = ss.data();
+      const float* __restrict psn = sn.data();
+      float* __restrict pb = b.data();
+      for (int k = 0; k < n; ++k) {
+        const float ck = pss[k] + psn[k];
+        const float q = pc[k] / (ck > 0.0f ? ck : 1.0f);
+        pb[k] = pr[k] * pm[k] * (ck > 0.0f ? q : none);
+      }
     }
     if (!mis_update(v, a, b)) {
       end = FlightEnd::Absorbed;
