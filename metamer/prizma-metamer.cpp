@@ -238,6 +238,7 @@ int run_delta_e(const DeltaECommand& cmd, const CommonOptions& common) {
 
 }  // namespace
 
+// long on purpose: the command line: each subcommand's options beside its call, as the other tools' mains.
 int main(int argc, char** argv) {
   const std::string program = "prizma-metamer";
   CLI::App app{"Designs metamers and lights that hide or reveal the difference between two materials.\n"

@@ -155,6 +155,7 @@ void check_options_used(const CliOptions& o) {
   }
 }
 
+// long on purpose: the relight batch in its order (checks, load, coefficients, relight, write together), each step a call.
 int run(const CliOptions& o) {
   if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show && !o.serve) {
     throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i, --show or --serve");

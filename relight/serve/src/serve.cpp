@@ -289,6 +289,7 @@ struct RelightServer::Impl {
   void routes();
 };
 
+// long on purpose: the route table: one short handler per URL, listed together so the API reads in one place.
 void RelightServer::Impl::routes() {
   const ConnectionLimits limits;
   server.set_payload_max_length(kMaxBodyBytes);
