@@ -14,7 +14,7 @@
 
 #include "prizma/spectral/data_path.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/out_of_memory.h"
 
 namespace OCIO = OCIO_NAMESPACE;
 

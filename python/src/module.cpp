@@ -50,7 +50,7 @@
 #include "prizma/spectral/spectral_exr.h"
 #include "prizma/spectral/spectrum.h"
 #include "prizma/spectral/spectrum_spec.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 #include "module_parts.h"
 #include "native_call.h"
 

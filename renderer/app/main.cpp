@@ -21,13 +21,13 @@
 #include "prizma/render/sample_range.h"
 #include "prizma/render/scene.h"
 #include "prizma/spectral/atomic_file.h"
-#include "prizma/spectral/cli_support.h"
+#include "prizma/tool/cli_support.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/output_group.h"
 #include "prizma/spectral/output_image.h"
 #include "prizma/spectral/spectral_exr.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/tool/tool_main.h"
 
 PRIZMA_TOOL_STARTUP_GUARD("prizma-render");
 
@@ -36,6 +36,7 @@ namespace {
 using prizma::spectral::InputError;
 namespace render = prizma::render;
 namespace spectral = prizma::spectral;
+namespace tool = prizma::tool;
 
 constexpr const char* kProgram = "prizma-render";
 
@@ -173,11 +174,11 @@ int merge_main(int argc, char** argv) {
   int threads = 0;
   app.add_option("shards", inputs, "shard files (spectral EXR written by prizma-render)")
       ->required()
-      ->check(spectral::non_empty_path());
-  app.add_option("-o,--output", output, "merged output file")->required()->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
+  app.add_option("-o,--output", output, "merged output file")->required()->check(tool::non_empty_path());
   app.add_option("--preview", preview,
                  "also write the default relight, as prizma-relight OUT -o PREVIEW does (.png, .tif, .jpg, .exr)")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_flag("--half", half, "write half floats");
   app.add_flag("--strict", strict, "refuse shards that leave a gap in the sample range (exit 2)");
   app.add_flag("--no-verify", no_verify,
@@ -185,10 +186,10 @@ int merge_main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
   app.add_flag("-v,--verbose", verbose, "name each shard and its samples as it is read");
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
-  if (const int rc = spectral::parse_command_line(app, argc - 1, argv + 1); rc >= 0) return rc;
+  if (const int rc = tool::parse_command_line(app, argc - 1, argv + 1); rc >= 0) return rc;
   std::optional<tbb::global_control> thread_limit;
   if (threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
-  return spectral::run_tool(kProgram, [&] {
+  return tool::run_tool(kProgram, [&] {
     check_outputs(output, "-o", preview);
     // Then again with the shards recorded as inputs (require_regular_file): -o or --preview naming
     // one is refused before any shard is read.
@@ -218,16 +219,16 @@ int merge_main(int argc, char** argv) {
     if (!quiet)
       std::cerr << kProgram << ": merged " << shards.size() << (shards.size() == 1 ? " shard" : " shards")
                 << ", samples " << merged.info.sample_range << " → " << output << "\n";
-    return spectral::kExitOk;
+    return tool::kExitOk;
   });
 }
 
 // The command line's options of a render, into `o`.
 void add_render_options(CLI::App& app, Options& o) {
   app.add_option("scene", o.scene, "scene file (JSON, docs/scene-format.md); with --resume, the file's own")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_option("-o,--output", o.output, "output spectral EXR (default: the scene's \"output\")")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   // --spp, --width, --height and --seed are read as text and checked as the scene's fields are (the
   // messages name the range); their value is a whole number: INT in --help.
   app.add_option("--spp", o.spp_text, "samples per pixel (renders samples [begin, begin + N); with --resume the total)")
@@ -256,11 +257,11 @@ void add_render_options(CLI::App& app, Options& o) {
   prizma::render_app::add_render_denoise_options(app, o.features, o.denoise, o.keep_raw);
   app.add_option("--preview", o.preview,
                  "also write the default relight, as prizma-relight OUT -o PREVIEW does (.png, .tif, .jpg, .exr)")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_option("--resume", o.resume,
                  "continue a partial (interrupted) render from the scene and options it records, up to "
                  "its target or --spp N in all, and merge (output defaults to this file)")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_flag("--no-verify", o.no_verify,
                "with --resume: read the file even when its pixels do not match prizma:checksum (re-encoded by "
                "another tool: docs/spectral-exr.md)");
@@ -272,7 +273,7 @@ void add_render_options(CLI::App& app, Options& o) {
   app.add_flag("-q,--quiet", o.quiet, "no progress bar or summary");
   app.add_flag("-v,--verbose", o.verbose, "print the scene, mode and statistics");
   app.add_option("--ocio", o.ocio, "refused: a render relights with the default config only (give --ocio to prizma-relight)")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
 }
 
 // The options that change what is rendered, checked as the scene's fields are (the messages name the
@@ -410,7 +411,7 @@ int render_main(Options& o) {
   std::optional<tbb::global_control> threads;
   if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
   std::optional<Plan> plan = plan_render(o, job);
-  if (!plan) return spectral::kExitOk;
+  if (!plan) return tool::kExitOk;
   const render::Scene& scene = plan->scene;
   const auto& st = scene.settings;
 
@@ -461,7 +462,7 @@ int render_main(Options& o) {
   write_outputs(image, output, plan->recorded.half, o.preview, o.threads,
                 {raw && !o.keep_raw.empty() ? &*raw : nullptr, o.keep_raw});
   print_summary(o, image, stats, output);
-  return stats.interrupted ? 128 + (g_signal.load() != 0 ? g_signal.load() : SIGINT) : spectral::kExitOk;
+  return stats.interrupted ? 128 + (g_signal.load() != 0 ? g_signal.load() : SIGINT) : tool::kExitOk;
 }
 
 }  // namespace
@@ -492,6 +493,6 @@ int main(int argc, char** argv) {
              "Docs: share/doc/prizma/renderer.md, scene-format.md; man prizma-render.");
   Options o;
   add_render_options(app, o);
-  if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
-  return spectral::run_tool(kProgram, [&] { return render_main(o); });
+  if (const int rc = tool::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  return tool::run_tool(kProgram, [&] { return render_main(o); });
 }

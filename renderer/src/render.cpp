@@ -23,7 +23,7 @@
 #include "prizma/render/wavelength_map.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 
 namespace prizma::render {
 namespace {

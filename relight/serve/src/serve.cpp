@@ -33,7 +33,7 @@
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 #include "serve_assets.h"
 
 namespace prizma::relight {
