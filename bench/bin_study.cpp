@@ -40,6 +40,7 @@ ps::SpectralImage aggregate_bins(const ps::SpectralImage& fine, int n) {
 
 }  // namespace
 
+// long on purpose: a bench's main: options, setup, timed runs and its one table, read top to bottom.
 int main(int argc, char** argv) {
   std::vector<std::string> scenes{"cube", "metamers"};
   std::vector<std::string> lights{"D65", "A", "F11", "LED-B3", "gaussian:550:10"};

@@ -69,6 +69,7 @@ double percentile(std::vector<double> v, double q) {
   return v[i];
 }
 
+// long on purpose: a bench: one fixture's setup and the timed loop with its counters.
 void BM_ExactVsCompressed4K(benchmark::State& state) {
   const auto limit = bench::limit_threads(state.range(0));
   const double load_start = bench::load_average();

@@ -43,6 +43,7 @@ struct Options {
 
 }  // namespace
 
+// long on purpose: a bench's main: options, setup, timed runs and its one table, read top to bottom.
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{"Error versus time of each wavelength-sampling method against a high-sample reference"};

@@ -121,6 +121,7 @@ std::string fmt(double v, int prec) {
 
 }  // namespace
 
+// long on purpose: a bench's main: options, setup, timed runs and its one table, read top to bottom.
 int main(int argc, char** argv) {
   std::string render_exe, csv_path, sampler, calibrate_exe;
   fs::path scene_path = bench::source_data_dir() / "scenes" / "bench_peer.json";

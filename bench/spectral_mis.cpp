@@ -64,6 +64,7 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
+// long on purpose: a bench's main: options, setup, timed runs and its one table, read top to bottom.
 int main(int argc, char** argv) {
   std::vector<std::string> scenes{"grey", "cube", "peer", "peer-grey", "metamers", "mri", "sky_haze", "cloud_vdb"};
   std::vector<std::string> methods{"spectral-tracking", "spectral-mis"};

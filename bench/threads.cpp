@@ -121,6 +121,7 @@ std::string load_average() {
 
 }  // namespace
 
+// long on purpose: a bench's main: options, setup, timed runs and its one table, read top to bottom.
 int main(int argc, char** argv) {
   Config cfg;
   cfg.scene = bench::source_data_dir() / "scenes" / "bench_peer.json";

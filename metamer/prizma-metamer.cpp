@@ -11,7 +11,7 @@
 
 #include "prizma/render/scene.h"
 #include "prizma/spectral/atomic_file.h"
-#include "prizma/spectral/cli_support.h"
+#include "prizma/tool/cli_support.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/data_path.h"
@@ -20,9 +20,10 @@
 #include "prizma/spectral/light_design.h"
 #include "prizma/spectral/metamer_design.h"
 #include "prizma/spectral/spectrum_spec.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/tool/tool_main.h"
 
 namespace ps = prizma::spectral;
+namespace tool = prizma::tool;
 
 namespace {
 
@@ -137,11 +138,11 @@ int run_metamer(const MetamerCommand& cmd, const CommonOptions& common) {
   std::vector<double> values;
   for (const ps::NamedLight& l : lights)
     values.push_back(ps::delta_e2000_under(albedo, result.reflectance, l.spectrum, options.colour));
-  if (common.quiet) return ps::kExitOk;
+  if (common.quiet) return tool::kExitOk;
   std::printf("metamer of %s written to %s (values %.3f..%.3f)\n", cmd.albedo.c_str(), cmd.output.c_str(),
               result.reflectance.min_value(), result.reflectance.max_value());
   print_table(lights, values, "dE00");
-  return ps::kExitOk;
+  return tool::kExitOk;
 }
 
 int run_light(const LightCommand& cmd, const CommonOptions& common) {
@@ -175,7 +176,7 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
       ps::design_light(a, b, cmd.hide ? ps::LightGoal::Hide : ps::LightGoal::Reveal, reference, primaries, options);
   ps::write_spectrum_csv(cmd.output, result.light, "relative_spd");
 
-  if (common.quiet) return ps::kExitOk;
+  if (common.quiet) return tool::kExitOk;
   std::printf("%s light written to %s\n", cmd.hide ? "hiding" : "revealing", cmd.output.c_str());
   if (!primaries.empty()) {
     std::printf("mix:");
@@ -187,7 +188,7 @@ int run_light(const LightCommand& cmd, const CommonOptions& common) {
   std::vector<double> values;
   for (const ps::NamedLight& l : lights) values.push_back(ps::delta_e2000_under(a, b, l.spectrum, options.colour));
   print_table(lights, values, "dE00");
-  return ps::kExitOk;
+  return tool::kExitOk;
 }
 
 int run_tabulate(const TabulateCommand& cmd) {
@@ -199,7 +200,7 @@ int run_tabulate(const TabulateCommand& cmd) {
   for (double l = cmd.from_nm; l < cmd.to_nm - 1e-9; l += cmd.step_nm) lambda.push_back(l);
   lambda.push_back(cmd.to_nm);
   ps::write_spectrum_csv(cmd.output, s.resampled(lambda), "value");
-  return ps::kExitOk;
+  return tool::kExitOk;
 }
 
 // The relighter's matrix for one light: XYZ of a pixel = Σ_bins weight · transport. Lets scripts
@@ -218,7 +219,7 @@ int run_weights(const WeightsCommand& cmd, const CommonOptions& common) {
     text += line;
   }
   ps::write_file_atomically(cmd.output, text);
-  return ps::kExitOk;
+  return tool::kExitOk;
 }
 
 int run_delta_e(const DeltaECommand& cmd, const CommonOptions& common) {
@@ -233,11 +234,12 @@ int run_delta_e(const DeltaECommand& cmd, const CommonOptions& common) {
   const Eigen::Vector3d lab_b = ps::xyz_to_lab(xyz_b, white);
   std::printf("Lab a: %.3f %.3f %.3f\nLab b: %.3f %.3f %.3f\ndE00: %.4f\n", lab_a[0], lab_a[1], lab_a[2], lab_b[0],
               lab_b[1], lab_b[2], ps::delta_e2000(lab_a, lab_b));
-  return ps::kExitOk;
+  return tool::kExitOk;
 }
 
 }  // namespace
 
+// long on purpose: the command line: each subcommand's options beside its call, as the other tools' mains.
 int main(int argc, char** argv) {
   const std::string program = "prizma-metamer";
   CLI::App app{"Designs metamers and lights that hide or reveal the difference between two materials.\n"
@@ -272,7 +274,7 @@ int main(int argc, char** argv) {
   sub_metamer->add_option("--albedo", metamer.albedo, "the reflectance to match")->required();
   sub_metamer->add_option("--match-light", metamer.match_light, "light under which both look the same")->required();
   sub_metamer->add_option("--split-light", metamer.split_light, "light under which they should differ most")->required();
-  sub_metamer->add_option("-o,--output", metamer.output, "output CSV (nm, reflectance)")->required()->check(ps::non_empty_path());
+  sub_metamer->add_option("-o,--output", metamer.output, "output CSV (nm, reflectance)")->required()->check(tool::non_empty_path());
   sub_metamer->add_option("--basis", metamer.basis, "number of B-spline basis functions (smoothness)")
       ->capture_default_str()->check(CLI::Range(6, 200));
   sub_metamer->add_option("--min", metamer.min_value, "lower bound of the reflectance")->capture_default_str();
@@ -283,7 +285,7 @@ int main(int argc, char** argv) {
       "light", "design a light (same luminance as --reference) that hides or reveals the difference of two albedos");
   sub_light->add_option("--albedo-a", light.albedo_a, "first albedo spectrum");
   sub_light->add_option("--albedo-b", light.albedo_b, "second albedo spectrum");
-  sub_light->add_option("--scene", light.scene, "scene JSON to read materials' albedos from")->check(ps::non_empty_path());
+  sub_light->add_option("--scene", light.scene, "scene JSON to read materials' albedos from")->check(tool::non_empty_path());
   sub_light->add_option("--material-a", light.material_a, "first material's name (or index) in --scene");
   sub_light->add_option("--material-b", light.material_b, "second material's name (or index) in --scene");
   sub_light->add_flag("--hide", light.hide, "make the two look the same (dE00 -> 0)");
@@ -298,7 +300,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   sub_light->add_option("-o,--output", light.output, "output CSV (nm, relative spectral power)")
       ->required()
-      ->check(ps::non_empty_path());
+      ->check(tool::non_empty_path());
 
   DeltaECommand delta;
   CLI::App* sub_delta = app.add_subcommand(
@@ -311,7 +313,7 @@ int main(int argc, char** argv) {
   CLI::App* sub_weights = app.add_subcommand(
       "weights", "write the relighter's X,Y,Z weights per bin for --light (white-normalised: sum of Y = 1)");
   sub_weights->add_option("--light", weights.light, "light spectrum")->capture_default_str();
-  sub_weights->add_option("-o,--output", weights.output, "output CSV (lo_nm, hi_nm, X, Y, Z)")->required()->check(ps::non_empty_path());
+  sub_weights->add_option("-o,--output", weights.output, "output CSV (lo_nm, hi_nm, X, Y, Z)")->required()->check(tool::non_empty_path());
 
   TabulateCommand tabulate;
   CLI::App* sub_tabulate = app.add_subcommand("tabulate", "write a spectrum spec as a CSV table (for scripts and plots)");
@@ -319,10 +321,10 @@ int main(int argc, char** argv) {
   sub_tabulate->add_option("--from", tabulate.from_nm, "first wavelength (nm)")->capture_default_str();
   sub_tabulate->add_option("--to", tabulate.to_nm, "last wavelength (nm)")->capture_default_str();
   sub_tabulate->add_option("--step", tabulate.step_nm, "step (nm)")->capture_default_str();
-  sub_tabulate->add_option("-o,--output", tabulate.output, "output CSV")->required()->check(ps::non_empty_path());
+  sub_tabulate->add_option("-o,--output", tabulate.output, "output CSV")->required()->check(tool::non_empty_path());
 
-  if (const int code = ps::parse_command_line(app, argc, argv); code >= 0) return code;
-  return ps::run_tool(program, [&]() {
+  if (const int code = tool::parse_command_line(app, argc, argv); code >= 0) return code;
+  return tool::run_tool(program, [&]() {
     // Only the chosen subcommand's output is set; refuse an unwritable one before any work.
     for (const std::string* out : {&metamer.output, &light.output, &tabulate.output, &weights.output})
       if (!out->empty()) ps::check_output_file(*out, "--output");

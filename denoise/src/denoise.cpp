@@ -16,7 +16,7 @@
 #include "kernel_simd.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/large_buffer.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 
 namespace prizma::denoise {
 

@@ -60,6 +60,7 @@ const char* kind_of(mode_t mode) {
   return "not a regular file";
 }
 
+// long on purpose: one walk over the path (links, kinds, folder) whose every refusal names the case.
 Resolved resolve(const fs::path& path) {
   Resolved r;
   const std::string p = quoted(path);

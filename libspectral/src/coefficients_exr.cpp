@@ -131,6 +131,7 @@ std::uint64_t add_coefficients_for_write(const SpectralImage& image, bool multi,
   return sum;
 }
 
+// long on purpose: one check per coefficient attribute and channel, each naming it, in the order the file holds them.
 void add_coefficients_for_read(const std::vector<CoefficientChannel>& channels, const Imf::Header& header,
                                const std::vector<std::string>& layers, int bins, SpectralImage& image,
                                Imf::FrameBuffer& fb, const Imath::Box2i& dw, const std::string& path) {

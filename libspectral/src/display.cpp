@@ -14,7 +14,7 @@
 
 #include "prizma/spectral/data_path.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/out_of_memory.h"
 
 namespace OCIO = OCIO_NAMESPACE;
 
@@ -176,6 +176,7 @@ std::vector<std::string> DisplayTransform::displays() const { return list_displa
 
 std::vector<std::string> DisplayTransform::colour_spaces() const { return list_colour_spaces(m_impl->config); }
 
+// long on purpose: OpenColorIO's GPU shader description copied field by field into ours.
 DisplayShader DisplayTransform::gpu_shader(const std::string& function_name) const {
   DisplayShader out;
   out.function_name = function_name;

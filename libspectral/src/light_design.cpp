@@ -52,6 +52,7 @@ void for_each_simplex_point(int size, int steps, const std::function<void(const 
 
 }  // namespace
 
+// long on purpose: one solve read in order (primaries, starts, projected ascent, power limit, result) sharing the tabulated XYZ.
 LightDesignResult design_light(const Spectrum& albedo_a, const Spectrum& albedo_b, LightGoal goal,
                                const Spectrum& reference_light, const std::vector<Spectrum>& primaries,
                                const LightDesignOptions& options) {

@@ -54,6 +54,7 @@ std::vector<NamedLight> standard_report_lights() {
   return lights;
 }
 
+// long on purpose: one solve read in order (checks, basis, start, the 26 Lab directions, verification) sharing the tabulated maps.
 MetamerResult design_metamer(const Spectrum& albedo, const Spectrum& match_light, const Spectrum& split_light,
                              const MetamerOptions& options) {
   // Options.

@@ -9,7 +9,8 @@
 
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/installed_prefix.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/out_of_memory.h"
+#include "prizma/spectral/startup_guard.h"
 
 namespace prizma::spectral {
 

@@ -195,18 +195,14 @@ namespace prizma::spectral::detail {
 
 HWY_EXPORT(RelightRowTermsSimd);
 
-std::vector<SimdLevel> relight_simd_levels() { return hwy_levels(HWY_DISPATCH_TABLE(RelightRowTermsSimd)); }
+namespace {
+const HwyKernel<RelightRowKernel> kRelightRow{HWY_DISPATCH_TABLE(RelightRowTermsSimd), SimdKernel::Relight};
+}  // namespace
 
-RelightRowKernel relight_row_kernel(SimdLevel level) {
-  return hwy_function(HWY_DISPATCH_TABLE(RelightRowTermsSimd), level);
-}
-
-SimdLevel relight_simd_level() {
-  return choose_simd_level(SimdKernel::Relight, relight_simd_levels());
-}
-
-RelightRowKernel relight_row_kernel() { return relight_row_kernel(relight_simd_level()); }
-
+std::vector<SimdLevel> relight_simd_levels() { return kRelightRow.levels(); }
+RelightRowKernel relight_row_kernel(SimdLevel level) { return kRelightRow.at(level); }
+SimdLevel relight_simd_level() { return kRelightRow.chosen_level(); }
+RelightRowKernel relight_row_kernel() { return kRelightRow.chosen(); }
 std::string relight_simd_target_name(SimdLevel level) { return hwy_target_name(level); }
 
 }  // namespace prizma::spectral::detail

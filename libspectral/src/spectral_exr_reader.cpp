@@ -28,7 +28,7 @@
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/large_buffer.h"
 #include "prizma/spectral/spectral_exr.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/out_of_memory.h"
 #include "text_util.h"
 
 namespace prizma::spectral {

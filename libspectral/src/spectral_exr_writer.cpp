@@ -31,7 +31,7 @@
 #include "prizma/spectral/light_spectrum.h"
 #include "prizma/spectral/output_group.h"
 #include "prizma/spectral/spectral_exr.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/out_of_memory.h"
 
 namespace prizma::spectral {
 namespace {

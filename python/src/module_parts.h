@@ -1,5 +1,5 @@
 #pragma once
-// What module.cpp and render_call.cpp share (the Python module prizma._prizma, docs/python.md).
+// What module.cpp and the *_call.cpp files share (the Python module prizma._prizma, docs/python.md).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "prizma/spectral/spectral_exr.h"
+#include "prizma/spectral/spectrum.h"
 
 namespace prizma::relight {
 class RelightSession;
@@ -37,6 +38,14 @@ py::dict image_to_py(spectral::SpectralImage&& image);
 
 // The dict prizma.Image._native() gives, as a SpectralImage (InputError naming the bad entry).
 spectral::SpectralImage image_from_dict(const py::dict& image);
+
+// A spectrum as Python gives it: a spec string, or a pair (wavelengths_nm, values) of equal-length
+// 1-D arrays (InputError naming `input` otherwise). colour_call.cpp.
+spectral::Spectrum spectrum_from(const py::handle& spec, const std::string& input);
+
+// Defines prizma._prizma's spectra and colour functions on `m` (colour_call.cpp): spectrum, xyz, lab,
+// delta_e2000, named_spectra, metamer, design_light.
+void bind_colour(py::module_& m);
 
 // prizma._prizma.denoise (denoise_call.cpp): variance "propagate" or "drop", guides "luminance" or
 // "features" (the image's guide layers too), the DenoiseOptions' window and patch radii, patch_k

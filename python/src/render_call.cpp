@@ -22,6 +22,7 @@
 #include "module_parts.h"
 #include "native_call.h"
 #include "prizma/render/render.h"
+#include "prizma/render/render_job.h"
 #include "prizma/render/resume.h"
 #include "prizma/render/sample_range.h"
 #include "prizma/render/scene.h"
@@ -83,6 +84,7 @@ RenderArguments render_arguments(const py::object& samples, const py::object& th
 
 }  // namespace
 
+// long on purpose: the render thread and its progress relay to Python share the lock, the queue and the pending Python error.
 py::dict render_scene(const std::string& scene_source, bool scene_is_json, const std::string& base_dir,
                       const py::object& samples, const py::object& threads, const py::object& seed,
                       const py::object& width, const py::object& height, const std::optional<std::string>& bins,
@@ -93,12 +95,7 @@ py::dict render_scene(const std::string& scene_source, bool scene_is_json, const
     const WithoutGil released;
     scene = scene_is_json ? render::load_scene_text(scene_source, "scene", base_dir) : render::load_scene(scene_source);
   }
-  render::RenderOverrides given = args.given;
-  render::apply_overrides(scene, given, "");
-  auto& st = scene.settings;
-  if (args.samples) st.sample_end = render::SampleRange::starting_at(st.sample_begin, *args.samples, "samples").end;
-  if (args.threads > 0) st.threads = args.threads;
-  given.samples = render::SampleRange{st.sample_begin, st.sample_end};
+  const render::RenderOverrides given = render::prepare_render(scene, {args.given, args.samples, args.threads, ""});
 
   std::atomic<bool> cancel{false};
   std::mutex mutex;
@@ -181,8 +178,7 @@ py::dict render_scene(const std::string& scene_source, bool scene_is_json, const
     throw py::error_already_set();
   }
   if (stats.interrupted) stop_if_exiting();  // the exit hook cancelled it
-  if (!scene_is_json) image.info.scene_path = std::filesystem::absolute(scene.source).lexically_normal().string();
-  image.info.render_options = render::overrides_to_json(given);
+  render::record_render(image, scene, given, !scene_is_json);
   py::dict out = image_to_py(std::move(image));
   py::dict s;
   s["paths"] = stats.paths;

@@ -24,13 +24,13 @@
 #include "prizma/relight/serve.h"
 #include "prizma/relight/terminal_preview.h"
 #include "prizma/spectral/atomic_file.h"
-#include "prizma/spectral/cli_support.h"
+#include "prizma/tool/cli_support.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/data_path.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/stderr_capture.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/tool/tool_main.h"
 
 PRIZMA_TOOL_STARTUP_GUARD("prizma-relight");
 
@@ -38,6 +38,7 @@ namespace {
 
 namespace relight = prizma::relight;
 namespace spectral = prizma::spectral;
+namespace tool = prizma::tool;
 using spectral::InputError;
 
 struct CliOptions {
@@ -155,6 +156,7 @@ void check_options_used(const CliOptions& o) {
   }
 }
 
+// long on purpose: the relight batch in its order (checks, load, coefficients, relight, write together), each step a call.
 int run(const CliOptions& o) {
   if (o.output.empty() && o.batch.empty() && !o.interactive && !o.show && !o.serve) {
     throw InputError("prizma-relight", "nothing to do: give -o FILE, --batch FILE, -i, --show or --serve");
@@ -266,7 +268,7 @@ int run(const CliOptions& o) {
     std::setlocale(LC_CTYPE, "");  // libedit reads the terminal's characters in the user's encoding
     relight::run_interactive_terminal(session, io, std::cerr);
   }
-  return spectral::kExitOk;
+  return tool::kExitOk;
 }
 
 // prizma-relight compress IN.exr -o OUT.exr [--compact] [--max-error DE]: adds spectral-basis
@@ -297,7 +299,7 @@ int run_compress(const std::string& input, const std::string& output, const reli
               << (options.compact ? " (compact: coefficients only, relightable by prizma-relight alone)" : "")
               << "\n";
   }
-  return spectral::kExitOk;
+  return tool::kExitOk;
 }
 
 int compress_main(int argc, char** argv) {
@@ -307,10 +309,10 @@ int compress_main(int argc, char** argv) {
   relight::CompressFileOptions options;
   bool no_verify = false, quiet = false;
   int threads = 0;
-  app.add_option("input", input, "spectral EXR with transport bins")->required()->check(spectral::non_empty_path());
+  app.add_option("input", input, "spectral EXR with transport bins")->required()->check(tool::non_empty_path());
   app.add_option("-o,--output", output, "the compressed spectral EXR (written atomically)")
       ->required()
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_flag("--compact", options.compact,
                "drop the transport bins (and variance): the file is then relit only from the coefficients");
   app.add_option("--max-error", options.criterion.max_delta_e,
@@ -319,11 +321,11 @@ int compress_main(int argc, char** argv) {
   app.add_flag("--no-verify", no_verify, "read the input even when its pixels do not match prizma:checksum");
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
-  if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  if (const int rc = tool::parse_command_line(app, argc, argv); rc >= 0) return rc;
   options.verify_checksum = !no_verify;
   std::optional<tbb::global_control> limit;
   if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
-  return spectral::run_tool("prizma-relight", [&] { return run_compress(input, output, options, quiet); });
+  return tool::run_tool("prizma-relight", [&] { return run_compress(input, output, options, quiet); });
 }
 
 }  // namespace
@@ -334,10 +336,10 @@ int main(int argc, char** argv) {
   CliOptions o;
   app.add_option("input", o.input, "spectral EXR written by prizma-render (or any reflective spectral EXR)")
       ->required()
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_option("-o,--output", o.output,
                  "output image: .png (8/16-bit), .tif, .jpg (8-bit), .exr (linear XYZ or --colour-space)")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_option("--light", o.lights,
                  "NAME=SPEC for one light layer, or SPEC for every layer; SPEC: D65, A, F11, LED-B1, "
                  "blackbody:3200K, gaussian:550:20, box:500:560, csv:FILE, off, …*SCALE (repeatable)")
@@ -350,14 +352,14 @@ int main(int argc, char** argv) {
   app.add_option("--colour-space,--color-space", o.colour_space,
                  "linear OCIO colour space for EXR output (refused with only a PNG/TIFF/JPEG output)");
   app.add_option("--ocio", o.ocio, "OpenColorIO config file (default: $OCIO, else Prizma's own)")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_flag("--absolute", o.absolute, "absolute light units (no normalisation to Y = 1 for white)");
   app.add_option("--bit-depth", o.bit_depth, "PNG/TIFF bit depth")->check(CLI::IsMember({8, 16}))->capture_default_str();
   app.add_option("--batch", o.batch, "JSON file listing outputs and their settings (docs/relight.md)")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_flag("-i,--interactive", o.interactive, "read commands from stdin (type 'help')");
   app.add_option("--preview", o.preview, "interactive: image rewritten after every change")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_flag("--show", o.show, "print a true-colour terminal thumbnail (with -i: draw the image at the start)");
   app.add_flag("--show-every", o.show_every, "interactive: draw the image after every change");
   app.add_flag("-v,--verbose", o.verbose, "echo data files, OCIO config and lights");
@@ -372,7 +374,7 @@ int main(int argc, char** argv) {
   app.add_option("--port", o.port, "--serve: port (0: a free one)")->check(CLI::Range(0, 65535))->capture_default_str();
   app.add_option("--save-dir", o.save_dir, "--serve: the folder the page's Save writes into")
       ->capture_default_str()
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.set_version_flag("--version", prizma::spectral::prizma_version());
   // Examples (tests/e2e/docs/check_help.py checks that every option they use exists).
   app.footer("Examples:\n"
@@ -386,11 +388,11 @@ int main(int argc, char** argv) {
              "Also: prizma-relight compress IN.exr -o OUT.exr [--compact] [--max-error DE] adds spectral-basis "
              "coefficients (prizma-relight compress --help).\n"
              "Docs: share/doc/prizma/relight.md; man prizma-relight.");
-  if (const int rc = spectral::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  if (const int rc = tool::parse_command_line(app, argc, argv); rc >= 0) return rc;
   o.display_given = app.count("--display") > 0;
   for (const char* name : {"--bind", "--port", "--save-dir"})
     if (app.count(name) > 0) o.serve_options_given.emplace_back(name);
   std::optional<tbb::global_control> threads;
   if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
-  return spectral::run_tool("prizma-relight", [&] { return run(o); });
+  return tool::run_tool("prizma-relight", [&] { return run(o); });
 }

@@ -211,6 +211,7 @@ spectral::XyzImage relight_compressed(const CompressedTransport& transport, cons
   return out;
 }
 
+// long on purpose: the bake and its check against the full transform belong together: one bisection state, then the check.
 DisplayEncoder8::DisplayEncoder8(const spectral::DisplayTransform& display) : m_display(&display) {
   const std::optional<spectral::DisplayMatrixCurve> split = display.split_matrix_curve();
   if (!split) return;

@@ -178,26 +178,19 @@ namespace prizma::relight::detail {
 HWY_EXPORT(CompressedRowToDisplay8);
 HWY_EXPORT(HalfToFloat);
 
-std::vector<spectral::SimdLevel> compressed_frame_levels() {
-  return spectral::detail::hwy_levels(HWY_DISPATCH_TABLE(CompressedRowToDisplay8));
-}
-std::vector<spectral::SimdLevel> half_to_float_levels() {
-  return spectral::detail::hwy_levels(HWY_DISPATCH_TABLE(HalfToFloat));
-}
+namespace {
+using spectral::SimdKernel;
+using spectral::detail::HwyKernel;
+const HwyKernel<CompressedRowKernel> kCompressedRow{HWY_DISPATCH_TABLE(CompressedRowToDisplay8), SimdKernel::CompressedFrame};
+const HwyKernel<HalfToFloatKernel> kHalfToFloat{HWY_DISPATCH_TABLE(HalfToFloat), SimdKernel::HalfToFloat};
+}  // namespace
 
-CompressedRowKernel compressed_row_kernel(spectral::SimdLevel level) {
-  return spectral::detail::hwy_function(HWY_DISPATCH_TABLE(CompressedRowToDisplay8), level);
-}
-CompressedRowKernel compressed_row_kernel() {
-  return compressed_row_kernel(spectral::choose_simd_level(spectral::SimdKernel::CompressedFrame, compressed_frame_levels()));
-}
-
-HalfToFloatKernel half_to_float_kernel(spectral::SimdLevel level) {
-  return spectral::detail::hwy_function(HWY_DISPATCH_TABLE(HalfToFloat), level);
-}
-HalfToFloatKernel half_to_float_kernel() {
-  return half_to_float_kernel(spectral::choose_simd_level(spectral::SimdKernel::HalfToFloat, half_to_float_levels()));
-}
+std::vector<spectral::SimdLevel> compressed_frame_levels() { return kCompressedRow.levels(); }
+std::vector<spectral::SimdLevel> half_to_float_levels() { return kHalfToFloat.levels(); }
+CompressedRowKernel compressed_row_kernel(spectral::SimdLevel level) { return kCompressedRow.at(level); }
+CompressedRowKernel compressed_row_kernel() { return kCompressedRow.chosen(); }
+HalfToFloatKernel half_to_float_kernel(spectral::SimdLevel level) { return kHalfToFloat.at(level); }
+HalfToFloatKernel half_to_float_kernel() { return kHalfToFloat.chosen(); }
 
 }  // namespace prizma::relight::detail
 #endif

@@ -9,7 +9,7 @@
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/default_lights.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 
 namespace prizma::relight {
 

@@ -11,16 +11,17 @@
 #include "denoise_command.h"
 #include "prizma/denoise/denoise.h"
 #include "prizma/spectral/atomic_file.h"
-#include "prizma/spectral/cli_support.h"
+#include "prizma/tool/cli_support.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/input_file.h"
 #include "prizma/spectral/spectral_exr.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/tool/tool_main.h"
 
 namespace prizma::render_app {
 
 namespace denoise = prizma::denoise;
 namespace spectral = prizma::spectral;
+namespace tool = prizma::tool;
 using spectral::InputError;
 
 void add_denoise_options(CLI::App& app, denoise::DenoiseOptions& o, std::string& variance, std::string& guides) {
@@ -68,7 +69,7 @@ void add_render_denoise_options(CLI::App& app, bool& features, bool& denoise, st
   app.add_flag("--denoise", denoise,
                "denoise the output after the last pass (implies --variance; docs/denoise.md); the file relights exactly");
   app.add_option("--keep-raw", keep_raw, "with --denoise: also write the raw render to this file (to resume or merge)")
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
 }
 
 void check_render_denoise(bool denoise, const std::string& keep_raw, bool shard, const std::string& resume,
@@ -109,21 +110,21 @@ int denoise_main(int argc, char** argv) {
   denoise::DenoiseOptions options;
   app.add_option("input", input, "spectral EXR with variance layers (a render, a merged or resumed file)")
       ->required()
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   app.add_option("-o,--output", output, "denoised spectral EXR (never the input)")
       ->required()
-      ->check(spectral::non_empty_path());
+      ->check(tool::non_empty_path());
   add_denoise_options(app, options, variance, guides);
   app.add_flag("--no-verify", no_verify,
                "read the input even when its pixels do not match prizma:checksum (docs/spectral-exr.md)");
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
   app.footer("Example:\n  prizma-render scene.json --variance --spp 64 -o raw.exr && prizma-render denoise raw.exr -o clean.exr");
-  if (const int rc = spectral::parse_command_line(app, argc - 1, argv + 1); rc >= 0) return rc;
+  if (const int rc = tool::parse_command_line(app, argc - 1, argv + 1); rc >= 0) return rc;
   finish_denoise_options(options, variance);
   std::optional<tbb::global_control> thread_limit;
   if (threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
-  return spectral::run_tool(kProgram, [&] {
+  return tool::run_tool(kProgram, [&] {
     // The input is recorded first, so that -o naming it (by any path) is refused before any work.
     spectral::require_regular_file(input, "an OpenEXR file");
     spectral::check_output_file(output, "-o");
@@ -146,7 +147,7 @@ int denoise_main(int argc, char** argv) {
                 << clean.height << ", " << clean.lights.size() << (clean.lights.size() == 1 ? " light" : " lights")
                 << ", " << clean.bins.size() << " bins) in " << seconds << " s → " << output << "\n"
                 << kProgram << ": " << variance_note(options) << "\n";
-    return spectral::kExitOk;
+    return tool::kExitOk;
   });
 }
 

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "prizma/denoise/denoise_options.h"
-#include "prizma/spectral/cli_support.h"
+#include "prizma/tool/cli_support.h"
 #include "prizma/spectral/spectral_exr.h"
 
 namespace prizma::render_app {

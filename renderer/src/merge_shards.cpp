@@ -116,6 +116,7 @@ void require_raw_samples(const spectral::SpectralImage& image, const std::string
                                ": samples cannot be added to filtered values (merge or --resume the raw renders, then denoise)");
 }
 
+// long on purpose: the shard checks and the weighted merge of every layer kind share one plan of sample counts.
 spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>& shards,
                                      const std::vector<std::string>& names) {
   if (shards.empty()) throw InputError("merge", "no shards to merge");

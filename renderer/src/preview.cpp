@@ -3,7 +3,7 @@
 #include "prizma/spectral/default_lights.h"
 #include "prizma/spectral/half_float.h"
 #include "prizma/spectral/output_image.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 
 namespace prizma::render {
 

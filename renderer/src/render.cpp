@@ -23,7 +23,7 @@
 #include "prizma/render/wavelength_map.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 
 namespace prizma::render {
 namespace {
@@ -351,6 +351,7 @@ namespace {
 
 // render() and render_folded(): `fold` chooses the lights' treatment (the sample loop is instantiated
 // for each, so the production loop has no branch for the test mode).
+// long on purpose: the one sample loop set-up per mode (single, tracking, MIS, fluorescence, folded), instantiated once each.
 spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& callbacks, RenderStats* stats_out,
                                      bool fold) {
   const auto start = std::chrono::steady_clock::now();

@@ -96,6 +96,7 @@ RenderOverrides overrides_from_json(const std::string& text, const std::string& 
   return o;
 }
 
+// long on purpose: the resume rules in order (scene, options, estimator, target), each refusal naming the option.
 ResumePlan plan_resume(const ResumeRequest& req) {
   const std::string file = req.file.string();
   ResumePlan plan;

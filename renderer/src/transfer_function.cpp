@@ -108,6 +108,7 @@ void validate_material(const Material& m, const std::string& input) {
   }
 }
 
+// long on purpose: the image checks and the row-runs → rules conversion, in the order an image is trusted.
 TransferFunction read_transfer_function_image(const std::filesystem::path& image, double extinction_scale,
                                               double lambda_lo_nm, double lambda_hi_nm,
                                               const ValueNormalisation& norm, const std::string& input) {

@@ -155,6 +155,7 @@ std::string datatype_name(int dt) {
 
 }  // namespace
 
+// long on purpose: the header checks, the guarded chunked read and the voxel conversion in the order a file is trusted.
 Volume load_nifti_volume(const std::filesystem::path& path) {
   const std::string input = path.string();
   spectral::require_regular_file(path, "a NIfTI file");

@@ -99,6 +99,7 @@ T load_element(const unsigned char* p, bool swap) {
 
 }  // namespace
 
+// long on purpose: name parsing, size checks before any allocation and the chunked read, in the order a file is trusted.
 Volume load_raw_volume(const RawVolumeSpec& spec) {
   const std::string input = spec.path.string();
   spectral::require_regular_file(spec.path, "a raw volume file");

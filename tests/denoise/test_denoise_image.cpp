@@ -12,7 +12,7 @@
 #include "denoise_test_util.h"
 #include "prizma/denoise/denoise.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 
 namespace prizma::denoise {
 namespace {

@@ -1,8 +1,8 @@
-// Out-of-memory classification of library error messages (tool_main.h): a file's own text never
+// Out-of-memory classification of library error messages (out_of_memory.h): a file's own text never
 // turns a corrupt-file error into "out of memory".
 #include <gtest/gtest.h>
 
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/out_of_memory.h"
 
 namespace prizma::spectral {
 namespace {

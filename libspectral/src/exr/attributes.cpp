@@ -14,7 +14,7 @@
 
 #include "exr/exr_common.h"
 #include "prizma/spectral/error.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 
 namespace prizma::spectral::exr {
 namespace {

@@ -33,7 +33,7 @@
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectrum_spec.h"
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
 #include "serve_assets.h"
 
 namespace prizma::relight {
@@ -289,6 +289,7 @@ struct RelightServer::Impl {
   void routes();
 };
 
+// long on purpose: the route table: one short handler per URL, listed together so the API reads in one place.
 void RelightServer::Impl::routes() {
   const ConnectionLimits limits;
   server.set_payload_max_length(kMaxBodyBytes);

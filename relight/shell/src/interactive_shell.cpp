@@ -253,6 +253,7 @@ bool parse_on_off(const std::string& s) {
   throw InputError("adapt", "on or off, not \"" + s + "\"");
 }
 
+// long on purpose: the shell's command table: one short branch per command, listed together.
 void run_command(RelightSession& session, Shell& shell, std::ostream& out, const std::vector<std::string>& w,
                  const InteractiveOptions& opts) {
   const std::string& cmd = w[0];

@@ -19,6 +19,7 @@
 
 namespace prizma::render {
 
+// long on purpose: the depth runs, current cell and roulette are state its segment and collision callbacks share (as transmittance<>).
 void PathTracer::transmittance_mis(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, ConstLanes<0> rho,
                                    int hero, Rng& rng, PathScratch& s, double t_max) const {
   // (One function of ~100 lines, as transmittance<> and free_flight_mis: the depth runs, the current

@@ -74,6 +74,7 @@ bool PathTracer::mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) c
   return true;
 }
 
+// long on purpose: the depth runs and current cell are state its segment and collision callbacks share (the collision is collide_mis).
 PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, PathScratch& s) const {
   // Distances at the hero's majorant μ̄_j (per lane: d_max·σt_m(λ_k) in a cell with a spectral bound,
   // else the cell's μ̄ for every lane), events with the hero's probabilities: σe,j/μ̄_j (absorption an

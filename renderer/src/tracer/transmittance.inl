@@ -4,6 +4,7 @@
 
 namespace prizma::render {
 
+// long on purpose: residual ratio tracking: the control runs, roulette and depth are state the segment and collision callbacks share.
 template <int kLanes>
 void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng,
                                PathScratch& s, double t_max) const {

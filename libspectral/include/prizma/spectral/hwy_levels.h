@@ -67,4 +67,22 @@ Fn hwy_function(const Fn* table, SimdLevel) {
 // "AVX3", "AVX2", "SSE4", "EMU128", …: Highway's name of the target behind a level.
 inline std::string hwy_target_name(SimdLevel level) { return hwy::TargetName(hwy_target_of(level)); }
 
+// A row kernel compiled for every level (`table`: HWY_DISPATCH_TABLE(Function)) and the SimdKernel
+// whose rule picks its level: the one dispatch of every Highway kernel here (the relight rows
+// here, the compressed relight rows and the half → float conversion in relight/).
+template <class Fn>
+struct HwyKernel {
+  const Fn* table;
+  SimdKernel kind;
+
+  // The levels it is built for that this CPU runs, lowest first (Baseline always).
+  std::vector<SimdLevel> levels() const { return hwy_levels(table); }
+  // The level choose_simd_level(kind, levels()) picks now (throws InputError("PRIZMA_SIMD", …)
+  // for an unknown value of the variable).
+  SimdLevel chosen_level() const { return choose_simd_level(kind, levels()); }
+  // The kernel at `level` (one of levels()), or at chosen_level(): look it up once per image.
+  Fn at(SimdLevel level) const { return hwy_function(table, level); }
+  Fn chosen() const { return at(chosen_level()); }
+};
+
 }  // namespace prizma::spectral::detail

@@ -11,7 +11,7 @@
 namespace prizma::spectral {
 
 namespace detail {
-// The real stderr while a StderrCapture is active (-1 otherwise): the fatal handlers of tool_main
+// The real stderr while a StderrCapture is active (-1 otherwise): the fatal handlers of startup_guard
 // (a library crashing or calling std::terminate while loading, e.g. the image module) put it back
 // so that their one line is seen, not lost in the capture's file.
 inline volatile int g_captured_stderr = -1;

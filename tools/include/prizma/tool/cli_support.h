@@ -4,9 +4,10 @@
 #include <iostream>
 #include <string>
 
-#include "prizma/spectral/tool_main.h"
+#include "prizma/spectral/version.h"
+#include "prizma/tool/tool_main.h"
 
-namespace prizma::spectral {
+namespace prizma::tool {
 
 // The check of every option that names a file or a folder: an empty value (a script's unset
 // variable, -o "$OUT") is refused as a usage error naming the option, never taken as "not given".
@@ -38,7 +39,7 @@ inline void name_path_values(CLI::App& app) {
 // "prog: error: <message>" and "Try 'prog --help'." to stderr and returns kExitUsage. Returns -1 when
 // parsing succeeded and the program should go on.
 inline int parse_command_line(CLI::App& app, int argc, const char* const* argv) {
-  end_startup_guard();
+  spectral::end_startup_guard();
   name_path_values(app);
   try {
     app.parse(argc, argv);
@@ -49,7 +50,7 @@ inline int parse_command_line(CLI::App& app, int argc, const char* const* argv) 
     std::cout << app.help("", CLI::AppFormatMode::All);
     return check_standard_output(app.get_name(), kExitOk);
   } catch (const CLI::CallForVersion&) {
-    std::cout << app.get_name() << " " << prizma_version() << "\n";
+    std::cout << app.get_name() << " " << spectral::prizma_version() << "\n";
     return check_standard_output(app.get_name(), kExitOk);
   } catch (const CLI::ParseError& e) {
     std::cerr << app.get_name() << ": error: " << e.what() << "\n"
@@ -59,4 +60,4 @@ inline int parse_command_line(CLI::App& app, int argc, const char* const* argv) 
   return -1;
 }
 
-}  // namespace prizma::spectral
+}  // namespace prizma::tool
