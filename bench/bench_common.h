@@ -162,6 +162,9 @@ inline spectral::SpectralImage cached_render(const render::Scene& scene, const f
       << render::wavelength_sampling_name(st.wavelength_sampling) << '|' << folded << '|'
       << st.write_variance << '|' << st.max_bounces << '|' << render::event_probabilities_name(st.event_probabilities);
   if (st.sampler != render::Sampler::Independent) key << '|' << render::sampler_name(st.sampler);  // older keys unchanged
+  // A render with guide layers is another file (bench_denoise_error --features denoises the cached bias
+  // render with them: one cached without would silently be denoised on the luminance alone).
+  if (st.write_guides) key << "|guides";  // older keys unchanged
   for (const auto& l : scene.lights) key << '|' << l.name << ':' << l.spectrum_spec;
   const fs::path file = cache_dir / (tag + "-" + hash_hex(key.str()) + ".exr");
   if (fs::exists(file)) {

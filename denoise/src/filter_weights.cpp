@@ -13,6 +13,7 @@
 #include <tbb/parallel_for.h>
 
 #include "kernel_simd.h"
+#include "prizma/denoise/denoise.h"
 #include "prizma/spectral/error.h"
 
 namespace prizma::denoise {
@@ -316,9 +317,32 @@ FilterWeights compute_weights(const DenoiseGuides& guides, const DenoiseOptions&
   return compute_weights(DenoiseGuides(guides), options);
 }
 
+namespace {
+
+// Each feature plane filtered by non-local means on itself (its own values and variances as the
+// guide), as NFOR filters its features before regressing on them (Bitterli et al. 2016): the
+// renderer's guides (depth, scatter fraction) are Monte Carlo means as noisy as the luminance, and
+// the feature test, made for nearly noise-free features, would cut neighbours that only differ by
+// that noise. A feature's own kernels keep its edges (two sides far apart beyond their noise), the
+// luminance's would blur the edges only the feature sees. The values become Σ W·f and the variances
+// Σ W²·V (the filtered estimate's variance with W held fixed). A plane without variance is noise-free
+// and kept. The kernels depend on the feature alone, so the weights stay independent of every light.
+void prefilter_features(DenoiseGuides& guides, const DenoiseOptions& options) {
+  for (GuidePlane& f : guides.features) {
+    if (f.variance.empty()) continue;
+    DenoiseGuides own{guides.width, guides.height, f, {}};
+    const FilterWeights w = compute_weights(std::move(own), options);
+    f.value = apply(w, f.value, 1, KernelPower::Weights);
+    f.variance = apply(w, f.variance, 1, KernelPower::SquaredWeights);
+  }
+}
+
+}  // namespace
+
 FilterWeights compute_weights(DenoiseGuides&& guides, const DenoiseOptions& options) {
   check_guides(guides);
   check_options(options);
+  prefilter_features(guides, options);
   auto derived = std::make_shared<FilterWeights::Derived>();
   derived->eps = distance_epsilon(guides.luminance);
   for (const GuidePlane& p : guides.features) {
