@@ -32,6 +32,7 @@
 #include "prizma/relight/compressed_relight.h"
 #include "prizma/spectral/relight_image.h"
 #include "prizma/relight/kernel_levels.h"
+#include "prizma/relight/light_spec.h"
 #include "prizma/spectral/colour.h"
 #include "prizma/spectral/spectral_exr.h"
 
