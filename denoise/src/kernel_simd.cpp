@@ -140,11 +140,27 @@ void MultiplyAddRows(const float* w, int w_stride, const float* v, int v_stride,
   }
 }
 
+// out[0, kVectors·lanes) = Σ_t w_t·in[delta_t·ch + ·) for kVectors whole vectors of channels, one
+// independent sum per vector, so that one tap's adds do not wait on each other's latency. Each value
+// is 0 + w₀v₀ + w₁v₁ + … in tap order whatever kVectors is: the same bits.
+template <int kVectors>
+HWY_INLINE void SumTaps(D d, const float* in, std::ptrdiff_t ch, const std::ptrdiff_t* delta, const float* w, int taps,
+                        float* out) {
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  V acc[kVectors];
+  for (int v = 0; v < kVectors; ++v) acc[v] = hn::Zero(d);
+  for (int t = 0; t < taps; ++t) {
+    const V wt = hn::Set(d, w[t]);
+    const float* src = in + delta[t] * ch;
+    for (int v = 0; v < kVectors; ++v) acc[v] = hn::Add(acc[v], hn::Mul(wt, hn::LoadU(d, src + v * lanes)));
+  }
+  for (int v = 0; v < kVectors; ++v) hn::StoreU(acc[v], d, out + v * lanes);
+}
+
 void ApplyPixel(const ApplyPlane* planes, int plane_count, std::ptrdiff_t pixel, const std::ptrdiff_t* delta,
                 const float* weight, const float* weight_squared, int taps) {
   const D d;
   const int lanes = static_cast<int>(hn::Lanes(d));
-  const V zero = hn::Zero(d);
   for (int k = 0; k < plane_count; ++k) {
     const ApplyPlane& pl = planes[k];
     const std::ptrdiff_t ch = pl.channels;
@@ -152,43 +168,12 @@ void ApplyPixel(const ApplyPlane* planes, int plane_count, std::ptrdiff_t pixel,
     const float* in = pl.in + pixel * ch;
     float* out = pl.out + pixel * ch;
     int c0 = 0;
-    // Four vectors of channels at a time: four independent sums, so one tap's adds do not wait on
-    // each other's latency. Each value is still 0 + w₀v₀ + w₁v₁ + … in tap order: the same bits.
-    for (; c0 + 4 * lanes <= pl.channels; c0 += 4 * lanes) {
-      V a0 = zero, a1 = zero, a2 = zero, a3 = zero;
-      for (int t = 0; t < taps; ++t) {
-        const V wt = hn::Set(d, w[t]);
-        const float* src = in + delta[t] * ch + c0;
-        a0 = hn::Add(a0, hn::Mul(wt, hn::LoadU(d, src)));
-        a1 = hn::Add(a1, hn::Mul(wt, hn::LoadU(d, src + lanes)));
-        a2 = hn::Add(a2, hn::Mul(wt, hn::LoadU(d, src + 2 * lanes)));
-        a3 = hn::Add(a3, hn::Mul(wt, hn::LoadU(d, src + 3 * lanes)));
-      }
-      hn::StoreU(a0, d, out + c0);
-      hn::StoreU(a1, d, out + c0 + lanes);
-      hn::StoreU(a2, d, out + c0 + 2 * lanes);
-      hn::StoreU(a3, d, out + c0 + 3 * lanes);
-    }
-    for (; c0 + 2 * lanes <= pl.channels; c0 += 2 * lanes) {  // 32 channels on AVX-512
-      V a0 = zero, a1 = zero;
-      for (int t = 0; t < taps; ++t) {
-        const V wt = hn::Set(d, w[t]);
-        const float* src = in + delta[t] * ch + c0;
-        a0 = hn::Add(a0, hn::Mul(wt, hn::LoadU(d, src)));
-        a1 = hn::Add(a1, hn::Mul(wt, hn::LoadU(d, src + lanes)));
-      }
-      hn::StoreU(a0, d, out + c0);
-      hn::StoreU(a1, d, out + c0 + lanes);
-    }
-    for (; c0 + lanes <= pl.channels; c0 += lanes) {
-      V acc = zero;
-      for (int t = 0; t < taps; ++t)
-        acc = hn::Add(acc, hn::Mul(hn::Set(d, w[t]), hn::LoadU(d, in + delta[t] * ch + c0)));
-      hn::StoreU(acc, d, out + c0);
-    }
+    for (; c0 + 4 * lanes <= pl.channels; c0 += 4 * lanes) SumTaps<4>(d, in + c0, ch, delta, w, taps, out + c0);
+    for (; c0 + 2 * lanes <= pl.channels; c0 += 2 * lanes) SumTaps<2>(d, in + c0, ch, delta, w, taps, out + c0);
+    for (; c0 + lanes <= pl.channels; c0 += lanes) SumTaps<1>(d, in + c0, ch, delta, w, taps, out + c0);
     if (c0 < pl.channels) {  // the last, partial vector: masked loads never touch memory past the image
       const auto m = hn::FirstN(d, static_cast<std::size_t>(pl.channels - c0));
-      V acc = zero;
+      V acc = hn::Zero(d);
       for (int t = 0; t < taps; ++t)
         acc = hn::Add(acc, hn::Mul(hn::Set(d, w[t]), hn::MaskedLoad(m, d, in + delta[t] * ch + c0)));
       hn::BlendedStore(acc, m, d, out + c0);
