@@ -95,15 +95,7 @@ void PathTracer::transmittance_mis(const Eigen::Vector3d& origin, const Eigen::V
       return false;
     }
     const float inv = rho_total / mix;
-    // T *= a·inv and P *= b·inv in one pass (the same bits; T, P, a, b are four scratch rows).
-    float* __restrict pt = T.data();
-    float* __restrict pp = P.data();
-    const float* __restrict pa = a.data();
-    const float* __restrict pb = b.data();
-    for (int i = 0; i < n; ++i) {
-      pt[i] *= pa[i] * inv;
-      pp[i] *= pb[i] * inv;
-    }
+    mis_detail::scale_both(n, inv, T.data(), P.data(), a.data(), b.data());  // T, P, a, b: four scratch rows
     return true;
   };
   auto on_segment = [&](const MajorantTraversal::Segment& seg, float& mu) {

@@ -51,6 +51,17 @@ inline void collision_lanes_per_lane(int n, float density, const float* __restri
   for (int i = 0; i < n; ++i) collision_lane(density, mu[i], sigma_t[i], albedo[i], sa[i], ss[i], sn[i]);
 }
 
+// x[i] *= a[i]·inv and y[i] *= b[i]·inv in one pass (the same bits as the two products apart): the
+// MIS update of the path's weights and densities, and of a shadow ray's T and P. x and y are rows
+// of their own; a and b are only read (they may be one row).
+inline void scale_both(int n, float inv, float* __restrict x, float* __restrict y, const float* __restrict a,
+                       const float* __restrict b) {
+  for (int i = 0; i < n; ++i) {
+    x[i] *= a[i] * inv;
+    y[i] *= b[i] * inv;
+  }
+}
+
 }  // namespace mis_detail
 
 bool PathTracer::mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) const {
@@ -63,14 +74,7 @@ bool PathTracer::mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) c
   mis_detail::sum2(rho.view(), rho * b, n, total, mix);
   if (!(mix > 0.0f) || !(total > 0.0f) || !std::isfinite(mix)) return false;  // no lane can go on
   const float inv = total / mix;  // 1 / S
-  float* __restrict pw = v.w.data();
-  float* __restrict pr = rho.data();
-  const float* __restrict pa = a.data();
-  const float* __restrict pb = b.data();
-  for (int i = 0; i < n; ++i) {
-    pw[i] *= pa[i] * inv;
-    pr[i] *= pb[i] * inv;
-  }
+  mis_detail::scale_both(n, inv, v.w.data(), rho.data(), a.data(), b.data());
   return true;
 }
 
