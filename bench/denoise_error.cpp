@@ -123,7 +123,10 @@ void save(const Options& o, const std::string& name, const ps::SpectralImage& im
 void measure_scene(const std::string& name, const Options& o, std::ostringstream& csv) {
   const pr::Scene scene = load(name, o);
   std::cerr << name << ": reference " << o.ref_spp << " spp (cached in " << o.cache << ")\n";
-  const ps::SpectralImage ref = pb::cached_render(with_samples(scene, o.ref_spp, o.seed + 1000003), o.cache, name + "-ref");
+  // The reference needs no guide layers: rendered without them, one cached reference serves every guide choice.
+  pr::Scene ref_scene = with_samples(scene, o.ref_spp, o.seed + 1000003);
+  ref_scene.settings.write_guides = false;
+  const ps::SpectralImage ref = pb::cached_render(ref_scene, o.cache, name + "-ref");
   std::vector<prizma::spectral::XyzImage> ref_xyz;
   std::vector<Eigen::Vector3d> white(o.lights.size());
   for (std::size_t k = 0; k < o.lights.size(); ++k) ref_xyz.push_back(pb::relight_all(ref, o.lights[k], &white[k]));
