@@ -8,6 +8,7 @@
 #include "prizma/render/render.h"
 #include "prizma/render/sample_range.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/guide_names.h"
 
 namespace prizma::render {
 namespace {
@@ -188,17 +189,29 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
       for (std::size_t k = 0; k < rs.size(); ++k) layer.reradiation[k] = static_cast<float>(rs[k] / n_total);
     }
   }
-  // Guide layers (--features): merged alike when every shard has the same ones, else dropped.
+  // Guide layers (--features): merged alike when every shard has the same ones (by name: a file read
+  // back lists them in its channels' order, a render in its own), else dropped.
+  auto find_guide = [](const spectral::SpectralImage& s, const std::string& guide_name) -> const spectral::GuideLayer* {
+    for (const spectral::GuideLayer& g : s.guides)
+      if (g.name == guide_name) return &g;
+    return nullptr;
+  };
   bool same_guides = true;
   for (const auto& s : shards) {
     same_guides = same_guides && s.guides.size() == first.guides.size();
-    for (std::size_t g = 0; same_guides && g < s.guides.size(); ++g)
-      same_guides = s.guides[g].name == first.guides[g].name && !s.guides[g].variance.empty();
+    for (std::size_t g = 0; same_guides && g < first.guides.size(); ++g) {
+      const spectral::GuideLayer* mine = find_guide(s, first.guides[g].name);
+      same_guides = mine && !mine->variance.empty();
+    }
   }
   if (!same_guides) out.guides.clear();
   for (std::size_t g = 0; g < out.guides.size(); ++g) {
-    merge_plane(shards, total, true, [g](const spectral::SpectralImage& s) {
-      return std::pair(&s.guides[g].value, &s.guides[g].variance);
+    // The first-hit guides are the same in every shard (hit_guides.h): kept as they are.
+    if (spectral::exact_guide(out.guides[g].name)) continue;
+    const std::string guide_name = out.guides[g].name;
+    merge_plane(shards, total, true, [&find_guide, guide_name](const spectral::SpectralImage& s) {
+      const spectral::GuideLayer* mine = find_guide(s, guide_name);
+      return std::pair(&mine->value, &mine->variance);
     }, out.guides[g].value, out.guides[g].variance);
   }
   out.info.samples = total;

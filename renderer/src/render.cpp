@@ -17,6 +17,7 @@
 #include "prizma/render/event_probability.h"
 #include "prizma/render/film.h"
 #include "prizma/render/fluorescence.h"
+#include "prizma/render/hit_guides.h"
 #include "prizma/render/path_tracer.h"
 #include "prizma/render/rng.h"
 #include "prizma/render/sample_range.h"
@@ -443,6 +444,9 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
   std::vector<std::string> names;
   for (const Light& light : scene.lights) names.push_back(light.name);
   spectral::SpectralImage img = film.image(names);
+  // --features: the Monte Carlo guides (the film's), then the deterministic first-hit ones.
+  if (st.write_guides)
+    for (spectral::GuideLayer& g : hit_guides(scene, camera, tracer)) img.guides.push_back(std::move(g));
   img.info.is_prizma = true;
   img.info.light_records = light_records(scene.lights);
   img.info.samples = done;
