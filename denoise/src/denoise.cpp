@@ -15,6 +15,7 @@
 
 #include "kernel_simd.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/guide_names.h"
 #include "prizma/spectral/large_buffer.h"
 #include "prizma/spectral/version.h"
 
@@ -78,10 +79,13 @@ std::vector<float> apply(const FilterWeights& weights, const std::vector<float>&
 std::string denoise_record(const FilterWeights& weights) {
   const DenoiseOptions& o = weights.options();
   const bool propagate = o.variance == VarianceOutput::Propagate;
+  const std::vector<std::string> guides = weights.guide_names();
+  // With first-hit guides the kernels are regressed on them (filter_weights.cpp, regress_tile).
+  const bool regressed = std::any_of(guides.begin(), guides.end(), [](const std::string& g) { return spectral::exact_guide(g); });
   const nlohmann::json record = {
-      {"method", "non-local means"},
+      {"method", regressed ? "non-local means and first-order regression" : "non-local means"},
       {"version", spectral::prizma_version()},
-      {"guides", weights.guide_names()},
+      {"guides", guides},
       {"variance", propagate ? "propagated" : "dropped"},
       {"parameters",
        {{"window_radius_px", o.window_radius_px},

@@ -3,6 +3,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -10,6 +11,7 @@
 #include "prizma/spectral/bispectral.h"
 #include "prizma/spectral/colour_matching.h"
 #include "prizma/spectral/error.h"
+#include "prizma/spectral/guide_names.h"
 #include "prizma/spectral/light_spectrum.h"
 
 namespace prizma::denoise {
@@ -103,7 +105,13 @@ DenoiseGuides luminance_guides(const spectral::SpectralImage& image) {
 
 DenoiseGuides image_guides(const spectral::SpectralImage& image) {
   DenoiseGuides g = luminance_guides(image);
-  for (const spectral::GuideLayer& layer : image.guides) g.features.push_back({layer.name, layer.value, layer.variance});
+  // The first-hit layers when the file has them (the Monte Carlo depth and scatter fraction beside
+  // them only cost: docs/denoise.md, "The first-hit guides"), else the Monte Carlo ones.
+  const bool any_exact = std::any_of(image.guides.begin(), image.guides.end(),
+                                     [](const spectral::GuideLayer& l) { return spectral::exact_guide(l.name); });
+  for (const spectral::GuideLayer& layer : image.guides)
+    if (!any_exact || spectral::exact_guide(layer.name))
+      g.features.push_back({layer.name, layer.value, layer.variance, spectral::exact_guide(layer.name)});
   return g;
 }
 

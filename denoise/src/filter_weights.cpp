@@ -12,6 +12,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Dense>
+
 #include "kernel_simd.h"
 #include "prizma/denoise/denoise.h"
 #include "prizma/spectral/error.h"
@@ -24,6 +26,8 @@ struct FilterWeights::Derived {
   float eps = 0.0f;
   std::vector<float> feature_tau;  // absolute, per feature
   std::vector<float> inv_k2;       // per pixel, row-major
+  std::vector<int> exact;          // indices of the exact features (the regression's)
+  std::vector<double> exact_scale; // 1 / each one's range over the image (1 for a constant plane)
 };
 
 namespace {
@@ -113,7 +117,7 @@ void gather_features(const WeightsContext& cx, const PixelRect& rect, int twp, T
   s.feature_value.resize(nf);
   s.feature_var.resize(nf);
   s.feature_den.resize(nf);
-  s.features.resize(nf);
+  s.features.clear();
   const float kf2 = cx.options.feature_k * cx.options.feature_k;
   for (int k = 0; k < nf; ++k) {
     const GuidePlane& p = g.features[k];
@@ -129,7 +133,8 @@ void gather_features(const WeightsContext& cx, const PixelRect& rect, int twp, T
         const float gx = 0.5f * (v[c + 1] - v[c - 1]), gy = 0.5f * (v[c + f_cols] - v[c - f_cols]);
         den[static_cast<std::size_t>(y) * twp + x] = kf2 * std::max({cx.feature_tau[k], var[c], gx * gx + gy * gy});
       }
-    s.features[k] = {s.feature_value[k].data(), s.feature_var[k].data(), den.data()};
+    // The exact features are regressed on (regress_tile), not tested.
+    if (!p.exact) s.features.push_back({s.feature_value[k].data(), s.feature_var[k].data(), den.data()});
   }
 }
 
@@ -174,7 +179,7 @@ void tile_weights(const WeightsContext& cx, const PixelRect& rect, const std::ve
   job.centre_t2 = cx.options.centre_threshold_se * cx.options.centre_threshold_se;
   job.inv_patch_area = 1.0f / static_cast<float>((2 * f + 1) * (2 * f + 1));
   job.features = s.features.data();
-  job.feature_count = static_cast<int>(g.features.size());
+  job.feature_count = static_cast<int>(s.features.size());
   job.feature_stride = twp + 2 * r;
   job.d2 = s.d2.data();
   job.hsum = s.hsum.data();
@@ -199,6 +204,58 @@ void tile_weights(const WeightsContext& cx, const PixelRect& rect, const std::ve
         }
     }
   for (int c = 0; c < job.candidates; ++c) detail::normalise_kernels(s.weights[c].data(), n * n, plane);
+}
+
+// λ of the regression below, relative to each feature's variance over the kernel: the fitted
+// slopes are shrunk by about 1/(1 + λ). On mri_head at 128² and 64 spp, 2 did best of 0.1, 0.5, 2,
+// 4 and 8 (docs/denoise.md, "The first-hit guides").
+constexpr double kExactRidge = 2.0;
+
+// First-order regression on the exact features (NFOR's, Bitterli et al. 2016, with the kernels
+// above as its weights): each pixel's kernel w becomes the row of the weighted least-squares hat
+// matrix that evaluates, at the pixel, the plane fitted over its window in the exact features,
+// H(q) = w_q · x_qᵀ (Xᵀ W X + Λ)⁻¹ e₁, x_q = (1, s·(f_q − f_p)) (each feature scaled by 1/its
+// range over the image), Λ a ridge on the feature terms only. Σ_q H(q) = 1 (the intercept's
+// equation) and a pixel whose kernel is its own keeps it.
+// The fit reconstructs detail the features see (the skin's normals, the albedo) that the kernels
+// alone average away. H depends on the guides only, so it is as light-independent as w.
+void regress_tile(const std::vector<int>& exact, const std::vector<double>& exact_scale, int r, const PixelRect& rect,
+                  TileScratch& s, int candidate = 0) {
+  const int m = static_cast<int>(exact.size());
+  if (m == 0) return;
+  const int n = 2 * r + 1, twp = detail::padded(rect.width), f_cols = twp + 2 * r;
+  const std::size_t plane = static_cast<std::size_t>(rect.height) * twp;
+  Eigen::MatrixXd a(m + 1, m + 1);
+  Eigen::VectorXd x(m + 1);
+  for (int y = 0; y < rect.height; ++y)
+    for (int px = 0; px < rect.width; ++px) {
+      const std::size_t t = static_cast<std::size_t>(y) * twp + px;
+      const std::size_t centre = static_cast<std::size_t>(y + r) * f_cols + px + r;
+      auto features_at = [&](int o) {
+        const std::size_t q = centre + static_cast<std::ptrdiff_t>(o / n - r) * f_cols + (o % n - r);
+        x[0] = 1.0;
+        for (int k = 0; k < m; ++k)
+          x[k + 1] = exact_scale[k] * (static_cast<double>(s.feature_value[exact[k]][q]) - s.feature_value[exact[k]][centre]);
+      };
+      a.setZero();
+      for (int o = 0; o < n * n; ++o) {
+        const double w = s.weights[candidate][o * plane + t];
+        if (w == 0.0) continue;
+        features_at(o);
+        a.selfadjointView<Eigen::Lower>().rankUpdate(x, w);  // the lower triangle, which ldlt() reads
+      }
+      // Ridge: λ times each feature's weighted variance over the kernel (a(0, 0) = Σw = 1), so
+      // the shrinkage is the same whatever the feature's scale or local spread; the small constant
+      // keeps a feature that is flat over the kernel out of the fit.
+      for (int k = 1; k <= m; ++k) a(k, k) += kExactRidge * std::max(a(k, k) - a(k, 0) * a(k, 0) / a(0, 0), 0.0) + 1e-9;
+      const Eigen::VectorXd c = a.ldlt().solve(Eigen::VectorXd::Unit(m + 1, 0));
+      for (int o = 0; o < n * n; ++o) {
+        float& w = s.weights[candidate][o * plane + t];
+        if (w == 0.0f) continue;
+        features_at(o);
+        w = static_cast<float>(w * x.dot(c));
+      }
+    }
 }
 
 // Averages `plane` over the (2s+1)² box around each pixel that lies inside the image, in double and
@@ -288,6 +345,7 @@ void FilterWeights::tile_kernels(const PixelRect& rect, std::vector<float>& out)
   Candidate chosen{1.0f / (m_options.patch_k * m_options.patch_k), nullptr};
   if (!m_derived->inv_k2.empty()) chosen.plane = &m_derived->inv_k2;
   tile_weights(cx, rect, {chosen}, s);
+  regress_tile(m_derived->exact, m_derived->exact_scale, m_options.window_radius_px, rect, s);
   // Offset-major, rows unpadded.
   const int k = kernel_size(), twp = detail::padded(rect.width);
   const std::size_t plane = static_cast<std::size_t>(rect.height) * twp, count = static_cast<std::size_t>(rect.pixel_count());
@@ -329,7 +387,7 @@ namespace {
 // and kept. The kernels depend on the feature alone, so the weights stay independent of every light.
 void prefilter_features(DenoiseGuides& guides, const DenoiseOptions& options) {
   for (GuidePlane& f : guides.features) {
-    if (f.variance.empty()) continue;
+    if (f.variance.empty() || f.exact) continue;
     DenoiseGuides own{guides.width, guides.height, f, {}};
     const FilterWeights w = compute_weights(std::move(own), options);
     f.value = apply(w, f.value, 1, KernelPower::Weights);
@@ -351,6 +409,14 @@ FilterWeights compute_weights(DenoiseGuides&& guides, const DenoiseOptions& opti
     derived->feature_tau.push_back(
         static_cast<float>(options.feature_tau * range * range) + std::numeric_limits<float>::min());
   }
+    for (std::size_t k = 0; k < guides.features.size(); ++k) {
+      const GuidePlane& p = guides.features[k];
+      if (!p.exact) continue;
+      const auto [lo, hi] = std::minmax_element(p.value.begin(), p.value.end());
+      const double range = static_cast<double>(*hi) - *lo;
+      derived->exact.push_back(static_cast<int>(k));
+      derived->exact_scale.push_back(range > 0.0 ? 1.0 / range : 1.0);
+    }
   if (options.patch_k_wide > 0.0f && options.patch_k_wide != options.patch_k)
     derived->inv_k2 = choose_inv_k2({guides, options, derived->eps, derived->feature_tau});
   FilterWeights w;

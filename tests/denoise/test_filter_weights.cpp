@@ -122,7 +122,7 @@ TEST(FilterWeights, AnEdgeOnlyAFeatureSeesIsKept) {
   // chroma: the luminance cannot separate them). With the feature the columns beside the step keep
   // their own side (≤ 2 % of the other side's weight); without it they mix (≥ 20 %).
   auto g = test::noisy_guides(kW, kH, 0.05f, 12, [](int, int) { return 1.0; });
-  GuidePlane depth{"depth", {}, {}};
+  GuidePlane depth{"depth", {}, {}, false};
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) depth.value.push_back(x < kW / 2 ? 1.0f : 2.0f);
   std::vector<float> side(static_cast<std::size_t>(kW) * kH);

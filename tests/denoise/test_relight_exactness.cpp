@@ -69,7 +69,7 @@ std::vector<double> relight_double(const spectral::SpectralImage& img, const spe
 // Relighting the denoised image = filtering the relit image: both through the float tools, and at
 // a few pixels against the kernel applied in double to the relit image.
 void expect_relighting_commutes(const spectral::SpectralImage& img, std::mt19937& rng, int trials) {
-  const FilterWeights w = compute_weights(luminance_guides(img));
+  const FilterWeights w = compute_weights(image_guides(img));  // the luminance, and the image's guide layers
   const spectral::SpectralImage den = denoise(img, w);
   for (int t = 0; t < trials; ++t) {
     const spectral::RelightMatrix m(img.bins, random_lights(static_cast<int>(img.lights.size()), rng), {});
@@ -107,6 +107,24 @@ TEST(RelightExactness, OneToFourLightsUnderRandomSpectra) {
 TEST(RelightExactness, WithAnEmissionLayer) {
   std::mt19937 rng(7);
   expect_relighting_commutes(noisy_image(3, true, 11), rng, 6);
+}
+
+TEST(RelightExactness, WithFirstHitGuides) {
+  // Exact guide layers: the kernels are regressed on them (and may have negative weights) and
+  // still depend on no light, so relighting still commutes with the filter.
+  spectral::SpectralImage img = noisy_image(3, false, 14);
+  std::mt19937 rng(15);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (const char* name : {"hit_depth", "hit_normal_x", "hit_albedo"}) {
+    spectral::GuideLayer g{name, std::vector<float>(img.pixel_count()), std::vector<float>(img.pixel_count(), 0.0f)};
+    for (std::size_t p = 0; p < img.pixel_count(); ++p)
+      g.value[p] = 0.05f * static_cast<float>(p % kW) + 0.1f * u(rng);  // a ramp with texture
+    img.guides.push_back(std::move(g));
+  }
+  const FilterWeights w = compute_weights(image_guides(img));
+  ASSERT_EQ(w.guide_names().size(), 4u);
+  EXPECT_NE(w.kernel(10, 3), compute_weights(luminance_guides(img)).kernel(10, 3));  // the regression is in effect
+  expect_relighting_commutes(img, rng, 6);
 }
 
 TEST(RelightExactness, ABispectralImage) {

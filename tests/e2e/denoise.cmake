@@ -55,10 +55,10 @@ prizma_denoise_case(resumed ${_render} "denoise|resumed.exr|-o|resumed_clean.exr
 prizma_denoise_case(features_merged ${_render} "merge|feat0.exr|feat1.exr|-o|feat.exr|-q" MUST_EXIST feat.exr
   FIXTURES_SETUP denoise_features)
 prizma_denoise_case(features_denoise ${_render} "denoise|feat.exr|-o|feat_clean.exr|--guides|features" MUST_EXIST feat_clean.exr
-  ERR_REGEX "denoised by prizma [^:]+: non-local means on luminance, depth, scatter. variance propagated"
+  ERR_REGEX "denoised by prizma [^:]+: non-local means and first-order regression on luminance, hit_albedo, .*hit_depth, .*hit_normal_z. variance propagated"
   FIXTURES_REQUIRED denoise_features)
 prizma_denoise_case(features_resume ${_render} "--resume|feat0.exr|--spp|4|--denoise|--features|-o|feat_rs.exr"
-  MUST_EXIST feat_rs.exr ERR_REGEX "non-local means on luminance, depth, scatter. variance propagated")
+  MUST_EXIST feat_rs.exr ERR_REGEX "non-local means and first-order regression on luminance, hit_albedo, .*hit_normal_z. variance propagated")
 prizma_denoise_case(features_by_default_not_used ${_render} "denoise|feat.exr|-o|feat_lum.exr" MUST_EXIST feat_lum.exr
   ERR_REGEX "non-local means on luminance. variance propagated" FIXTURES_REQUIRED denoise_features)
 prizma_denoise_case(features_relight ${_relight} "feat.exr|--light|side=A|-o|feat.png" MUST_EXIST feat.png

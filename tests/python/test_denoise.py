@@ -68,15 +68,19 @@ def test_render_denoise_is_denoise_of_the_kept_raw_render(tiny_scene, tmp_path):
     run_tool("render", tiny_scene, "--denoise", "--features", "--keep-raw", raw, "-o", clean, "-q")
     kept = prizma.read(raw)
     assert kept.attributes["denoised"] is None and set(kept.variance) == {"side", "sky"}
-    # --features: the guide layers, light-independent means in [0, 1], which --denoise then uses.
-    assert set(kept.guides) == {"depth", "scatter"} and set(kept.guide_variance) == {"depth", "scatter"}
-    assert kept.guides["depth"].shape == (8, 8)
+    # --features: the guide layers, light-independent means in [0, 1]: the Monte Carlo ones and the
+    # first-hit ones (hit_*), which --denoise then uses.
+    hit = {n for n in kept.guides if n.startswith("hit_")}
+    assert {"hit_depth", "hit_normal_x", "hit_normal_y", "hit_normal_z", "hit_albedo", "hit_density"} <= hit
+    assert set(kept.guides) == {"depth", "scatter"} | hit and set(kept.guide_variance) == set(kept.guides)
+    assert kept.guides["depth"].shape == (8, 8) and kept.guides["hit_depth"].shape == (8, 8)
     assert 0.0 <= kept.guides["scatter"].min() and kept.guides["scatter"].max() <= 1.0
     assert 0.0 < kept.guides["scatter"].max() and kept.guides["depth"].min() < 1.0
     ours, theirs = prizma.denoise(kept, guides="features"), prizma.read(clean)
     for name in kept.lights:
         np.testing.assert_array_equal(ours.lights[name], theirs.lights[name])
         np.testing.assert_array_equal(ours.variance[name], theirs.variance[name])
-    assert theirs.attributes["denoised"]["guides"] == ["luminance", "depth", "scatter"]
+    used = theirs.attributes["denoised"]["guides"]
+    assert used[0] == "luminance" and set(used[1:]) == hit  # the first-hit layers, not the Monte Carlo ones
     assert theirs.guides == {}  # the guides served the weights; the denoised file keeps none
     assert prizma.denoise(kept).attributes["denoised"]["guides"] == ["luminance"]  # the default

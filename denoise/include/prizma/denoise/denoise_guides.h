@@ -15,6 +15,10 @@ struct GuidePlane {
   std::string name;
   std::vector<float> value;
   std::vector<float> variance;
+  // True for a plane that is not a Monte Carlo estimate (the renderer's first-hit guides,
+  // spectral::exact_guide): its variance is the spread within the pixel, not noise, so the weights
+  // use it as it is, without filtering it first.
+  bool exact = false;
 };
 
 // The guides of one image. `luminance` (with its variance) drives the patch distances; each feature
@@ -40,8 +44,9 @@ struct DenoiseGuides {
 DenoiseGuides luminance_guides(const spectral::SpectralImage& image);
 
 // luminance_guides(image) with the image's guide layers (SpectralImage::guides: prizma-render
-// --features) as feature planes, named after them: the guides of a rendered file. Throws as
-// luminance_guides.
+// --features) as feature planes, named after them: the guides of a rendered file. When the image
+// has first-hit layers (spectral::exact_guide: "hit_…") only those, marked exact; else every layer
+// (the Monte Carlo depth and scatter fraction). Throws as luminance_guides.
 DenoiseGuides image_guides(const spectral::SpectralImage& image);
 
 // Throws InputError (input "image") for an image that is already denoised (info.denoised set):

@@ -34,8 +34,9 @@ class FilterWeights {
   int kernel_size() const { return (2 * m_options.window_radius_px + 1) * (2 * m_options.window_radius_px + 1); }
 
   // The kernel of pixel (x, y): kernel_size() weights W(p, q) over the neighbours q = (x + dx, y + dy),
-  // row-major in (dy, dx) ∈ [−r, r]²: index (dy + r)·(2r + 1) + dx + r. Non-negative, zero for
-  // neighbours outside the image, summing to 1 (to float rounding). Throws std::out_of_range for a
+  // row-major in (dy, dx) ∈ [−r, r]²: index (dy + r)·(2r + 1) + dx + r. Zero for neighbours outside
+  // the image, summing to 1 (to float rounding); non-negative unless the guides have exact features
+  // (GuidePlane::exact), whose first-order regression may give some neighbours negative weights. Throws std::out_of_range for a
   // pixel outside the image.
   std::vector<float> kernel(int x, int y) const;
 
