@@ -8,7 +8,10 @@
 //   bench_denoise_error [--scenes cube_sphere,mri_head,cloud_vdb,bench_peer] [--size 256]
 //       [--spp 16,64,256] [--bias-spp 4096] [--ref-spp 16384] [--threads 2]
 //       [--lights D65,F11,gaussian:450:10] [--cache build-bench/cache] [--out FILE.csv]
-//       [--images DIR] [--guides luminance|features] [--features] [--references-only]
+//       [--images DIR] [--guides luminance,features,monte-carlo] [--features] [--references-only]
+//       [--window R] [--patch F] [--strength K] [--strength-wide K] [--feature-k K] [--centre-threshold T]
+//
+// Several guide choices (comma-separated) denoise the same raw renders, one CSV row each.
 //
 // relMSE = mean over pixels and X, Y, Z of (x − r)² / (r² + ε), ε = 0.01 (Rousselle et al. 2011,
 // Bitterli et al. 2016; white has Y = 1). The reference's own noise adds E[(r − E r)²/(r² + ε)] to
@@ -26,6 +29,7 @@
 
 #include "bench_common.h"
 #include "prizma/denoise/denoise.h"
+#include "prizma/spectral/guide_names.h"
 
 namespace pb = prizma::bench;
 namespace pd = prizma::denoise;
@@ -48,17 +52,25 @@ struct Options {
   std::string cache = "build-bench/cache";
   std::string out = "build-bench/results/denoise_error.csv";
   std::string images;
-  std::string guides = "luminance";
+  std::vector<std::string> guides{"luminance"};
+  pd::DenoiseOptions denoise;
   std::uint64_t seed = 1;
   bool references_only = false;
 };
 
 // The guides the weights are computed from. "luminance": the white luminance of the transport;
-// "features": that and the guide layers the renders then write (--features: depth, scatter).
+// "features": that and the guide layers the renders then write (--features), as the tools take them
+// (image_guides: the first-hit layers); "monte-carlo": the luminance and the Monte Carlo layers
+// (depth, scatter) only, as the tools took them before the first-hit layers existed.
 pd::DenoiseGuides make_guides(const ps::SpectralImage& img, const std::string& kind) {
   if (kind == "luminance") return pd::luminance_guides(img);
   if (kind == "features") return pd::image_guides(img);
-  throw ps::InputError("--guides", "unknown guides \"" + kind + "\" (known: luminance, features)");
+  if (kind == "monte-carlo") {
+    ps::SpectralImage mc = img;
+    std::erase_if(mc.guides, [](const ps::GuideLayer& l) { return ps::exact_guide(l.name); });
+    return pd::image_guides(mc);
+  }
+  throw ps::InputError("--guides", "unknown guides \"" + kind + "\" (known: luminance, features, monte-carlo)");
 }
 
 double rel_mse(const std::vector<float>& x, const std::vector<float>& r) {
@@ -89,7 +101,8 @@ pr::Scene load(const std::string& name, const Options& o) {
   pr::Scene s = pr::load_scene(path, {{"camera.width", std::to_string(o.size)}, {"camera.height", std::to_string(o.size)}});
   s.settings.threads = o.threads;
   s.settings.write_variance = true;
-  s.settings.write_guides = o.guides == "features";  // changes no bit of the transport
+  // Changes no bit of the transport (the render's time includes the first-hit march).
+  s.settings.write_guides = std::any_of(o.guides.begin(), o.guides.end(), [](const std::string& g) { return g != "luminance"; });
   return s;
 }
 
@@ -105,10 +118,10 @@ struct Denoised {
   double seconds = 0.0;
 };
 
-Denoised run_denoiser(const ps::SpectralImage& raw, const std::string& guides) {
+Denoised run_denoiser(const ps::SpectralImage& raw, const std::string& guides, const pd::DenoiseOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   Denoised d;
-  d.image = pd::denoise(raw, pd::compute_weights(make_guides(raw, guides)));
+  d.image = pd::denoise(raw, pd::compute_weights(make_guides(raw, guides), options));
   d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return d;
 }
@@ -142,9 +155,10 @@ void measure_scene(const std::string& name, const Options& o, std::ostringstream
     const ps::SpectralImage raw = bias_run ? pb::cached_render(s, o.cache, name + "-bias", &raw_seconds)
                                            : pr::render(s, {}, &stats);
     if (!bias_run) raw_seconds = stats.wall_seconds;
-    const Denoised den = run_denoiser(raw, o.guides);
     save(o, name + "-" + std::to_string(n) + "spp-raw", raw);
-    save(o, name + "-" + std::to_string(n) + "spp-denoised", den.image);
+    for (const std::string& guides : o.guides) {
+    const Denoised den = run_denoiser(raw, guides, o.denoise);
+    save(o, name + "-" + std::to_string(n) + "spp-denoised" + (guides == "luminance" ? "" : "-" + guides), den.image);
     for (std::size_t k = 0; k < o.lights.size(); ++k) {
       const auto xr = pb::relight_all(raw, o.lights[k]), xd = pb::relight_all(den.image, o.lights[k]);
       const double er = rel_mse(xr.xyz, ref_xyz[k].xyz), ed = rel_mse(xd.xyz, ref_xyz[k].xyz);
@@ -155,15 +169,18 @@ void measure_scene(const std::string& name, const Options& o, std::ostringstream
       const double de_raw = delta_e_p99(xr, ref_xyz[k], white[k]), de_den = delta_e_p99(xd, ref_xyz[k], white[k]);
       csv << name << ',' << n << ',' << o.lights[k] << ',' << raw_seconds << ',' << den.seconds << ',' << er << ','
           << ed << ',' << floor << ',' << erc << ',' << edc << ',' << (bias_run ? 0.0 : ratio) << ',' << de_raw << ','
-          << de_den << ',' << o.ref_spp << ',' << o.size << ',' << o.guides << '\n';
-      std::cerr << "  " << std::setw(5) << n << " spp  " << std::setw(16) << std::left << o.lights[k] << std::right
+          << de_den << ',' << o.ref_spp << ',' << o.size << ',' << guides << '\n';
+      std::cerr << "  " << std::setw(5) << n << " spp  " << std::setw(10) << std::left << guides << std::right
+                << std::setw(16) << std::left << o.lights[k] << std::right
                 << std::fixed << std::setprecision(3) << " raw " << raw_seconds << " s + denoise " << den.seconds
                 << " s  relMSE raw " << std::scientific << std::setprecision(3) << erc << " denoised " << edc
                 << std::fixed << std::setprecision(2);
       if (bias_run)
         std::cerr << "  dE00 p99 raw " << de_raw << " denoised " << de_den << "\n";
       else
-        std::cerr << "  equal-error ratio " << ratio << "x  dE00 p99 " << de_den << "\n";
+        std::cerr << "  equal-error ratio " << ratio << "x  reduction " << (edc > 0.0 ? erc / edc : INFINITY)
+                  << "x  dE00 p99 " << de_den << "\n";
+    }
     }
   }
 }
@@ -183,8 +200,17 @@ int main(int argc, char** argv) {
   app.add_option("--cache", o.cache, "folder of cached references and bias renders (outside git)");
   app.add_option("--out", o.out, "CSV output");
   app.add_option("--images", o.images, "folder to write the raw, denoised and reference EXR files into");
-  app.add_option("--guides", o.guides, "guides of the weights: luminance, or features (the renders' guide layers too)");
-  app.add_flag_callback("--features", [&o] { o.guides = "features"; }, "the same as --guides features");
+  app.add_option("--guides", o.guides,
+                 "guides of the weights, one or more: luminance, features (the renders' first-hit guide layers "
+                 "too), monte-carlo (their depth and scatter layers instead)")
+      ->delimiter(',');
+  app.add_flag_callback("--features", [&o] { o.guides = {"features"}; }, "the same as --guides features");
+  app.add_option("--window", o.denoise.window_radius_px, "denoiser window radius");
+  app.add_option("--patch", o.denoise.patch_radius_px, "denoiser patch radius");
+  app.add_option("--strength", o.denoise.patch_k, "denoiser patch k");
+  app.add_option("--strength-wide", o.denoise.patch_k_wide, "denoiser second patch k (0: none)");
+  app.add_option("--feature-k", o.denoise.feature_k, "denoiser feature k");
+  app.add_option("--centre-threshold", o.denoise.centre_threshold_se, "denoiser centre test threshold");
   app.add_option("--seed", o.seed, "seed of the measured renders (the reference uses seed + 1000003)");
   app.add_flag("--references-only", o.references_only, "only render (and cache) the references and bias renders");
   CLI11_PARSE(app, argc, argv);
