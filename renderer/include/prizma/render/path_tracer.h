@@ -48,7 +48,7 @@ struct PathInputs {
   std::vector<float> lo_nm;     // [lanes]
   std::vector<float> width_nm;  // [lanes]
   // Spectral MIS (WavelengthSampling::SpectralMis): the lane the path is sampled for, set before
-  // every trace() (WavelengthMap::hero_lane: a stratified draw over the bins).
+  // every trace() (WavelengthMap::draw's hero: a stratified draw over the bins).
   int hero_lane = 0;
 };
 
