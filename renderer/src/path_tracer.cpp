@@ -107,12 +107,7 @@ void PathTracer::prepare(PathScratch& s, int lanes) const {
   c.stamp.assign(nm, 0);
   c.path_id = 0;
   PathWork& w = s.work;
-  for (auto* v : {&w.weight, &w.transmittance, &w.optical_depth, &w.phase, &w.sigma_a, &w.sigma_s, &w.sigma_n})
-    v->assign(n, 0.0f);
-  // (Spectral MIS's; sized for every tracer, so that estimate_transmittance_mis can be called.)
-  for (auto* v : {&w.mis_pdf, &w.mis_rate, &w.mis_depth, &w.mis_ratio, &w.mis_factor, &w.mis_contribution,
-                  &w.shadow_pdf})
-    v->assign(n, 0.0f);
+  w.transmittance.assign(n, 0.0f);
   PathResult& out = s.out;
   out.environment.assign(n, 0.0f);
   out.emission.assign(n, 0.0f);
@@ -195,12 +190,15 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
   std::copy(s.in.lambda_nm.begin(), s.in.lambda_nm.end(), cache.lambda_nm.begin());
   cache.new_wavelengths();
   PathResult& out = s.out;
-  const Lanes<kLanes> w = lanes_of<kLanes>(s.work.weight, n);
-  PathState<kLanes> v{n, w, kMis ? lanes_of<kLanes>(s.work.mis_pdf, n) : w, out.environment.data(),
-                      out.emission.data(), out.directional.data(), camera_ray.origin, camera_ray.direction};
+  PathState<kLanes> v(n);
+  v.env = out.environment.data();
+  v.em = out.emission.data();
+  v.dir_out = out.directional.data();
+  v.pos = camera_ray.origin;
+  v.dir = camera_ray.direction;
   v.w = 1.0f;
   if constexpr (kMis) {
-    v.mix = 1.0f;
+    v.rho = 1.0f;
     v.hero = s.in.hero_lane;
   }
   v.lanes(v.env) = 0.0f;
@@ -245,9 +243,9 @@ void PathTracer::trace_lanes(const Ray& camera_ray, Rng& rng, PathScratch& s) co
     const bool g_constant = kLanes == 1 || v.isotropic || m_g_constant[v.material];
     estimate_lights(v, g, g_constant, rng, s);
     if constexpr (kMis) {
-      if (!sample_phase_hero(v, g, g_constant, rng, s)) return;
+      if (!sample_phase_hero(v, g, g_constant, rng)) return;
     } else {
-      if (!sample_phase(v, g, g_constant, rng, s)) return;
+      if (!sample_phase(v, g, g_constant, rng)) return;
     }
     if (!roulette(v, rng)) return;
     if (!intersect_box(Ray{v.pos, v.dir}, m_medium->bounds_min, m_medium->bounds_max, v.t_enter, v.t_exit)) {

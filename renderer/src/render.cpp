@@ -77,7 +77,6 @@ struct RenderContext {
   // (−2) or a directional light (its index in the tracer's directional results).
   std::vector<int> source;
   bool fluorescent = false;  // fluor.any in all-bins or single mode: paths may fluoresce
-  bool mis = false;          // spectral MIS with several lanes: each sample's hero lane is set
   // Single mode: pair_index[out·nb + in] is the bispectral pair of (out, in), −1 if none.
   std::vector<int> pair_index;
   Film& film;
@@ -107,8 +106,9 @@ class PixelRenderer {
       const double px = x + rng.uniform_double();
       const double py = y + rng.uniform_double();
       const Ray ray = m_c.camera.generate(px, py);
-      const WavelengthDraw draw = m_c.map.draw(rng, ps.in.lambda_nm.data());
-      if (m_c.mis) ps.in.hero_lane = m_c.map.hero_lane(st.seed, pix, s);
+      const SampleIndex at{.seed = st.seed, .pixel = pix, .sample = s};
+      const WavelengthDraw draw = m_c.map.draw(rng, ps.in.lambda_nm.data(), at);
+      if (draw.hero >= 0) ps.in.hero_lane = draw.hero;
       m_c.tracer.trace(ray, rng, ps);
       ++ts.paths;
 
@@ -377,7 +377,7 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
     mode = LaneMode::Single;
   else if (tracer.wavelength_independent())
     mode = LaneMode::Replicated;
-  const WavelengthMap map(mode, bins);
+  const WavelengthMap map(mode, bins, sampling == WavelengthSampling::SpectralMis);
   // Fluorescence (docs/fluorescence.md): the bispectral pairs the scene can fill; nothing of it
   // runs for a scene without fluorescence.
   const FluorescenceLayout fluor = fluorescence_layout(scene.medium, bins);
@@ -433,8 +433,7 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
   });
 
   std::atomic<bool> pass_cut{false};
-  const bool mis = sampling == WavelengthSampling::SpectralMis && mode == LaneMode::AllBins;
-  const RenderContext context{st,   camera, tracer, map, fluor, source, fluorescent, mis, std::move(pair_index),
+  const RenderContext context{st,   camera, tracer, map, fluor, source, fluorescent, std::move(pair_index),
                               film, callbacks.cancel, pass_cut};
   bool interrupted = false;
   const std::int64_t done = fold ? run_passes(context, folded, states, callbacks, start, interrupted)

@@ -7,7 +7,10 @@
 #include <sys/stat.h>
 
 #include <cstring>
+#include <functional>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "prizma/render/scene.h"
 #include "prizma/spectral/error.h"
@@ -56,6 +59,23 @@ inline void expect_error(const ScratchDir& dir, const json& j, const std::string
   } catch (const InputError& e) {
     EXPECT_EQ(e.input(), path.string() + (field.empty() ? "" : ": " + field)) << e.what();
     EXPECT_NE(e.reason().find(reason), std::string::npos) << e.what();
+  }
+}
+
+// A row of a table of loader errors: an edit of base_scene() and the error it must give.
+struct BadEdit {
+  std::string field;   // the error's input after "<file>: "
+  std::string reason;  // part of its reason
+  std::function<void(json&)> edit;
+};
+
+// Each row on a fresh base_scene(): expect_error(dir, edited scene, field, reason).
+inline void expect_errors(const ScratchDir& dir, const std::vector<BadEdit>& rows) {
+  for (const BadEdit& row : rows) {
+    SCOPED_TRACE(row.field + ": " + row.reason);
+    json j = base_scene();
+    row.edit(j);
+    expect_error(dir, j, row.field, row.reason);
   }
 }
 

@@ -9,74 +9,38 @@ using namespace scene_test;
 
 TEST(SceneLoaderErrors, Lights) {
   ScratchDir dir;
-  json j = base_scene();
-  j["lights"][1]["name"] = "side";
-  expect_error(dir, j, "lights[1].name", "duplicate light name");
-  j = base_scene();
-  j["lights"][0]["name"] = "key light";
-  expect_error(dir, j, "lights[0].name", "letters, digits");
-  j = base_scene();
-  j["lights"][0]["name"] = "";
-  expect_error(dir, j, "lights[0].name", "1 to 64");
-  j = base_scene();
-  j["lights"] = json::array();
-  expect_error(dir, j, "lights", "at least one light");
-  j = base_scene();
-  j.erase("lights");
-  expect_error(dir, j, "lights", "is required");
-  j = base_scene();
-  j["lights"][0]["angular_size_deg"] = 180;
-  expect_error(dir, j, "lights[0].angular_size_deg", "[0, 180)");
-  j = base_scene();
-  j["lights"][0].erase("direction");
-  expect_error(dir, j, "lights[0].direction", "is required");
+  expect_errors(dir, {
+      {"lights[1].name", "duplicate light name", [](json& j) { j["lights"][1]["name"] = "side"; }},
+      {"lights[0].name", "letters, digits", [](json& j) { j["lights"][0]["name"] = "key light"; }},
+      {"lights[0].name", "1 to 64", [](json& j) { j["lights"][0]["name"] = ""; }},
+      {"lights", "at least one light", [](json& j) { j["lights"] = json::array(); }},
+      {"lights", "is required", [](json& j) { j.erase("lights"); }},
+      {"lights[0].angular_size_deg", "[0, 180)", [](json& j) { j["lights"][0]["angular_size_deg"] = 180; }},
+      {"lights[0].direction", "is required", [](json& j) { j["lights"][0].erase("direction"); }},
+  });
 }
 
 TEST(SceneLoaderErrors, CameraAndSettings) {
   ScratchDir dir;
+  expect_errors(dir, {
+      {"camera.width", "must be in [1, 16384] (got 0)", [](json& j) { j["camera"]["width"] = 0; }},
+      {"camera.fov_deg", "(0, 180)", [](json& j) { j["camera"]["fov_deg"] = 180; }},
+      {"camera.look_at", "must differ from position", [](json& j) { j["camera"]["look_at"] = {0, 0, 3}; }},
+      {"camera.up", "parallel", [](json& j) { j["camera"]["up"] = {0, 0, -1}; }},
+      // its square overflows: once "up parallel", misleading
+      {"camera.position[0]", "must be within ±1e12 (got 1e+200)",
+       [](json& j) { j["camera"]["position"] = {1e200, 0.5, 0.5}; }},
+      {"camera.look_at[1]", "must be within ±1e12", [](json& j) { j["camera"]["look_at"] = {0, -1e13, 0}; }},
+      {"camera.type", "perspective", [](json& j) { j["camera"]["type"] = "fisheye"; }},
+      {"samples", "must be in [1,", [](json& j) { j["samples"] = 0; }},
+      {"seed", "≥ 0", [](json& j) { j["seed"] = -1; }},
+      {"max_bounces", "[-1,", [](json& j) { j["max_bounces"] = -2; }},
+      {"wavelength_sampling", "spectral-tracking", [](json& j) { j["wavelength_sampling"] = "hero"; }},
+      {"sampler", "known: independent, sobol", [](json& j) { j["sampler"] = "halton"; }},
+      {"event_probabilities", "\"max\", \"average\"", [](json& j) { j["event_probabilities"] = "maximum"; }},
+      {"output", "must not be empty", [](json& j) { j["output"] = ""; }},
+  });
   json j = base_scene();
-  j["camera"]["width"] = 0;
-  expect_error(dir, j, "camera.width", "must be in [1, 16384] (got 0)");
-  j = base_scene();
-  j["camera"]["fov_deg"] = 180;
-  expect_error(dir, j, "camera.fov_deg", "(0, 180)");
-  j = base_scene();
-  j["camera"]["look_at"] = {0, 0, 3};
-  expect_error(dir, j, "camera.look_at", "must differ from position");
-  j = base_scene();
-  j["camera"]["up"] = {0, 0, -1};
-  expect_error(dir, j, "camera.up", "parallel");
-  j = base_scene();
-  j["camera"]["position"] = {1e200, 0.5, 0.5};  // its square overflows: once "up parallel", misleading
-  expect_error(dir, j, "camera.position[0]", "must be within ±1e12 (got 1e+200)");
-  j = base_scene();
-  j["camera"]["look_at"] = {0, -1e13, 0};
-  expect_error(dir, j, "camera.look_at[1]", "must be within ±1e12");
-  j = base_scene();
-  j["camera"]["type"] = "fisheye";
-  expect_error(dir, j, "camera.type", "perspective");
-  j = base_scene();
-  j["samples"] = 0;
-  expect_error(dir, j, "samples", "must be in [1,");
-  j = base_scene();
-  j["seed"] = -1;
-  expect_error(dir, j, "seed", "≥ 0");
-  j = base_scene();
-  j["max_bounces"] = -2;
-  expect_error(dir, j, "max_bounces", "[-1,");
-  j = base_scene();
-  j["wavelength_sampling"] = "hero";
-  expect_error(dir, j, "wavelength_sampling", "spectral-tracking");
-  j = base_scene();
-  j["sampler"] = "halton";
-  expect_error(dir, j, "sampler", "known: independent, sobol");
-  j = base_scene();
-  j["event_probabilities"] = "maximum";
-  expect_error(dir, j, "event_probabilities", "\"max\", \"average\"");
-  j = base_scene();
-  j["output"] = "";
-  expect_error(dir, j, "output", "must not be empty");
-  j = base_scene();
   j["bins"] = "linear:700:400:12";
   const auto path = write_scene(dir, j);
   try {

@@ -119,18 +119,14 @@ TEST(SceneLoaderErrors, MissingFile) {
 
 TEST(SceneLoaderErrors, UnknownFields) {
   ScratchDir dir;
-  json j = base_scene();
-  j["sampels"] = 4;
-  expect_error(dir, j, "sampels", "unknown field");
-  j = base_scene();
-  j["materials"][1]["albdo"] = 0.5;
-  expect_error(dir, j, "materials[1].albdo", "unknown field");
-  j = base_scene();
-  j["camera"]["fov"] = 30;
-  expect_error(dir, j, "camera.fov", "unknown field");
-  j = base_scene();
-  j["volume"]["dims"] = {16, 16, 16};  // raw-only field on a procedural volume
-  expect_error(dir, j, "volume.dims", "unknown field");
+  expect_errors(dir, {
+      {"sampels", "unknown field", [](json& j) { j["sampels"] = 4; }},
+      {"materials[1].albdo", "unknown field", [](json& j) { j["materials"][1]["albdo"] = 0.5; }},
+      {"camera.fov", "unknown field", [](json& j) { j["camera"]["fov"] = 30; }},
+      // raw-only field on a procedural volume
+      {"volume.dims", "unknown field",
+       [](json& j) { j["volume"]["dims"] = {16, 16, 16}; }},
+  });
 }
 
 TEST(SceneLoaderErrors, DuplicateKeys) {
@@ -152,24 +148,14 @@ TEST(SceneLoaderErrors, NumberBeyondDouble) {
 
 TEST(SceneLoaderErrors, WrongTypes) {
   ScratchDir dir;
-  json j = base_scene();
-  j["samples"] = "8";
-  expect_error(dir, j, "samples", "must be an integer");
-  j = base_scene();
-  j["samples"] = 2.5;
-  expect_error(dir, j, "samples", "must be an integer");
-  j = base_scene();
-  j["camera"]["position"] = {0, 0};
-  expect_error(dir, j, "camera.position", "array of 3 numbers");
-  j = base_scene();
-  j["lights"][0]["direction"][1] = "up";
-  expect_error(dir, j, "lights[0].direction[1]", "must be a number");
-  j = base_scene();
-  j["materials"][0]["albedo"] = json::array({0.5});
-  expect_error(dir, j, "materials[0].albedo", "spectrum spec");
-  j = base_scene();
-  j["materials"] = json::object();
-  expect_error(dir, j, "materials", "must be an array");
+  expect_errors(dir, {
+      {"samples", "must be an integer", [](json& j) { j["samples"] = "8"; }},
+      {"samples", "must be an integer", [](json& j) { j["samples"] = 2.5; }},
+      {"camera.position", "array of 3 numbers", [](json& j) { j["camera"]["position"] = {0, 0}; }},
+      {"lights[0].direction[1]", "must be a number", [](json& j) { j["lights"][0]["direction"][1] = "up"; }},
+      {"materials[0].albedo", "spectrum spec", [](json& j) { j["materials"][0]["albedo"] = json::array({0.5}); }},
+      {"materials", "must be an array", [](json& j) { j["materials"] = json::object(); }},
+  });
 }
 
 // issue 11: deeply nested JSON crashed (SIGSEGV in nlohmann's recursive dump); now one InputError.

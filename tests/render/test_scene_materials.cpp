@@ -25,36 +25,22 @@ TEST(SceneLoader, NormalisedRangesAndOrthographicCamera) {
 
 TEST(SceneLoaderErrors, OutOfRangeMaterialValues) {
   ScratchDir dir;
-  json j = base_scene();
-  j["materials"][0]["extinction"]["scale"] = -3;
-  expect_error(dir, j, "materials[0].extinction.scale", "must be > 0 (got -3)");
-  j = base_scene();
-  j["materials"][1]["albedo"] = 1.5;
-  expect_error(dir, j, "materials[1].albedo", "[0, 1]");
-  j = base_scene();
-  j["materials"][1]["albedo"] = {{"spectrum", "cc:19"}, {"scale", 3}};  // patch 19 (white) ≈ 0.9 → 2.7
-  expect_error(dir, j, "materials[1].albedo", "[0, 1]");
-  j = base_scene();
-  j["materials"][0]["extinction"] = -1;
-  expect_error(dir, j, "materials[0].extinction", "≥ 0");
-  j = base_scene();
-  j["materials"][0]["anisotropy"] = 1.0;
-  expect_error(dir, j, "materials[0].anisotropy", "(-1, 1)");
-  j = base_scene();
-  j["materials"][0]["range"] = {150, 50};
-  expect_error(dir, j, "materials[0].range", "lo must be ≤ hi");
-  j = base_scene();
-  j["materials"][1]["density"] = {{200, 1}, {100, 2}};
-  expect_error(dir, j, "materials[1].density[1][0]", "strictly increasing");
-  j = base_scene();
-  j["materials"][1]["density"] = {{200, -1}};
-  expect_error(dir, j, "materials[1].density[0][1]", "≥ 0");
-  j = base_scene();
-  j["materials"][1]["name"] = "cube";
-  expect_error(dir, j, "materials[1].name", "duplicate material name");
-  j = base_scene();
-  j["materials"] = json::array();
-  expect_error(dir, j, "materials", "at least one");
+  expect_errors(dir, {
+      {"materials[0].extinction.scale", "must be > 0 (got -3)",
+       [](json& j) { j["materials"][0]["extinction"]["scale"] = -3; }},
+      {"materials[1].albedo", "[0, 1]", [](json& j) { j["materials"][1]["albedo"] = 1.5; }},
+      // patch 19 (white) ≈ 0.9 → 2.7
+      {"materials[1].albedo", "[0, 1]",
+       [](json& j) { j["materials"][1]["albedo"] = {{"spectrum", "cc:19"}, {"scale", 3}}; }},
+      {"materials[0].extinction", "≥ 0", [](json& j) { j["materials"][0]["extinction"] = -1; }},
+      {"materials[0].anisotropy", "(-1, 1)", [](json& j) { j["materials"][0]["anisotropy"] = 1.0; }},
+      {"materials[0].range", "lo must be ≤ hi", [](json& j) { j["materials"][0]["range"] = {150, 50}; }},
+      {"materials[1].density[1][0]", "strictly increasing",
+       [](json& j) { j["materials"][1]["density"] = {{200, 1}, {100, 2}}; }},
+      {"materials[1].density[0][1]", "≥ 0", [](json& j) { j["materials"][1]["density"] = {{200, -1}}; }},
+      {"materials[1].name", "duplicate material name", [](json& j) { j["materials"][1]["name"] = "cube"; }},
+      {"materials", "at least one", [](json& j) { j["materials"] = json::array(); }},
+  });
 }
 
 // Anisotropy is signed, so a csv: table of g may hold negative values (backward scattering); the
@@ -111,21 +97,19 @@ TEST(SceneLoaderErrors, BadSpectrumSpecsNameTheField) {
 // passed validation and the render never ended.
 TEST(SceneLoader, RefusesExtinctionTheTrackerCannotRepresent) {
   ScratchDir dir;
-  json j = base_scene();
-  j["materials"][1]["extinction"] = 1e39;  // beyond float
-  expect_error(dir, j, "materials[1].extinction", "extinction × density reaches");
-  j = base_scene();
-  j["materials"][1]["extinction"] = 2e6;
-  expect_error(dir, j, "materials[1].extinction", "per unit length");
-  j = base_scene();
-  j["materials"][0]["extinction"] = 1000;
-  j["materials"][0]["density"] = 5000;  // 5e6 per unit
-  expect_error(dir, j, "materials[0].extinction", "extinction × density reaches");
-  j = base_scene();
-  j["materials"][1]["density"] = {{200, 0.5}, {255, 1e300}};
-  expect_error(dir, j, "materials[1].density[1][1]", "must be at most");
+  expect_errors(dir, {
+      // beyond float
+      {"materials[1].extinction", "extinction × density reaches",
+       [](json& j) { j["materials"][1]["extinction"] = 1e39; }},
+      {"materials[1].extinction", "per unit length", [](json& j) { j["materials"][1]["extinction"] = 2e6; }},
+      // 5e6 per unit
+      {"materials[0].extinction", "extinction × density reaches",
+       [](json& j) { j["materials"][0]["extinction"] = 1000; j["materials"][0]["density"] = 5000; }},
+      {"materials[1].density[1][1]", "must be at most",
+       [](json& j) { j["materials"][1]["density"] = {{200, 0.5}, {255, 1e300}}; }},
+  });
   // The bound itself is fine, and an extinction outside any voxel's material costs nothing.
-  j = base_scene();
+  json j = base_scene();
   j["materials"][1]["extinction"] = 1e6;
   EXPECT_NO_THROW(load_scene(write_scene(dir, j)));
 }

@@ -54,33 +54,21 @@ TEST(SceneLoader, TransferFunctionImage) {
 
 TEST(SceneLoaderErrors, VolumeAndTransferFunction) {
   ScratchDir dir;
+  expect_errors(dir, {
+      {"volume.type", "\"raw\", \"nifti\", \"vdb\" or \"procedural\"", [](json& j) { j["volume"]["type"] = "dicom"; }},
+      {"volume.name", "unknown procedural volume", [](json& j) { j["volume"]["name"] = "teapot"; }},
+      {"volume.resolution", "must be in [2, 2048]", [](json& j) { j["volume"]["resolution"] = 1; }},
+      {"volume.spacing[1]", "must be > 0", [](json& j) { j["volume"]["spacing"] = {1, 0, 1}; }},
+      {"volume.voxel_type", "unknown voxel type",
+       [](json& j) { j["volume"] = {{"type", "raw"}, {"path", "v_2x2x2_uint8.raw"}, {"voxel_type", "uint12"}}; }},
+      {"volume.endianness", "\"little\" or \"big\"",
+       [](json& j) { j["volume"] = {{"type", "raw"}, {"path", "v_2x2x2_uint8.raw"}, {"endianness", "middle"}}; }},
+      {"volume", "is required", [](json& j) { j.erase("volume"); }},
+      {"transfer_function", "not both",
+       [](json& j) { j["transfer_function"] = {{"image", "tf.png"}, {"extinction_scale", 1}}; }},
+      {"materials", "is required", [](json& j) { j.erase("materials"); }},
+  });
   json j = base_scene();
-  j["volume"]["type"] = "dicom";
-  expect_error(dir, j, "volume.type", "\"raw\", \"nifti\", \"vdb\" or \"procedural\"");
-  j = base_scene();
-  j["volume"]["name"] = "teapot";
-  expect_error(dir, j, "volume.name", "unknown procedural volume");
-  j = base_scene();
-  j["volume"]["resolution"] = 1;
-  expect_error(dir, j, "volume.resolution", "must be in [2, 2048]");
-  j = base_scene();
-  j["volume"]["spacing"] = {1, 0, 1};
-  expect_error(dir, j, "volume.spacing[1]", "must be > 0");
-  j = base_scene();
-  j["volume"] = {{"type", "raw"}, {"path", "v_2x2x2_uint8.raw"}, {"voxel_type", "uint12"}};
-  expect_error(dir, j, "volume.voxel_type", "unknown voxel type");
-  j = base_scene();
-  j["volume"] = {{"type", "raw"}, {"path", "v_2x2x2_uint8.raw"}, {"endianness", "middle"}};
-  expect_error(dir, j, "volume.endianness", "\"little\" or \"big\"");
-  j = base_scene();
-  j.erase("volume");
-  expect_error(dir, j, "volume", "is required");
-  j = base_scene();
-  j["transfer_function"] = {{"image", "tf.png"}, {"extinction_scale", 1}};
-  expect_error(dir, j, "transfer_function", "not both");
-  j = base_scene();
-  j.erase("materials");
-  expect_error(dir, j, "materials", "is required");
   j.erase("materials");
   j["transfer_function"] = {{"image", "tf.png"}, {"extinction_scale", -5}};
   expect_error(dir, j, "transfer_function.extinction_scale", "must be > 0 (got -5)");

@@ -95,6 +95,31 @@ TEST(SpectralMis, HeroLanesTakeEveryBinOncePerCycleAndSpreadOverFewerSamples) {
   }
 }
 
+TEST(SpectralMis, TheWavelengthDrawCarriesTheHeroLaneOnlyUnderSpectralMis) {
+  // WavelengthMap::draw is the one sampler: the lanes' wavelengths and, in all-bins mode with a hero,
+  // hero_lane(seed, pixel, sample); −1 in every other mode. The hero takes no random number: the
+  // wavelengths are those of the draw without it.
+  const spectral::BinLayout bins = spectral::BinLayout::linear(400, 700, 12);
+  const WavelengthMap hero(LaneMode::AllBins, bins, true), plain(LaneMode::AllBins, bins);
+  const WavelengthMap single(LaneMode::Single, bins, true), replicated(LaneMode::Replicated, bins, true);
+  EXPECT_TRUE(hero.has_hero());
+  EXPECT_FALSE(plain.has_hero());
+  EXPECT_FALSE(single.has_hero());
+  EXPECT_FALSE(replicated.has_hero());
+  std::vector<float> a(12), b(12);
+  for (std::int64_t s = 0; s < 30; ++s) {
+    const SampleIndex at{.seed = 9, .pixel = 77, .sample = s};
+    Rng ra(9, 77, static_cast<std::uint64_t>(s)), rb(9, 77, static_cast<std::uint64_t>(s));
+    const WavelengthDraw dh = hero.draw(ra, a.data(), at), dp = plain.draw(rb, b.data(), at);
+    EXPECT_EQ(dh.hero, hero.hero_lane(9, 77, s));
+    EXPECT_EQ(dp.hero, -1);
+    EXPECT_EQ(dh.u, dp.u);
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(single.draw(ra, a.data(), at).hero, -1);
+    EXPECT_EQ(replicated.draw(ra, a.data(), at).hero, -1);
+  }
+}
+
 TEST(SpectralMis, SpectralBoundsHoldEveryPointOfTheirCells) {
   // The per-lane majorant d_max·σt_m(λ) of a cell with a spectral bound must bound d·σt_m(λ) at
   // every point of it, with the point's material m: a random trilinear volume with overlapping rules

@@ -5,7 +5,7 @@
 
 namespace prizma::render {
 
-void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch& s) const {
+void PathTracer::fluoresce(int m, float density, float k, float* weights, Rng& rng, PathScratch& s) const {
   // The event's weight on the out side, a_i = w_i·d·Φ_i·c/(μ̄·mf) (the spectral-tracking factor of
   // the event), then the lanes carry λin with weights p_j. The path's transport is rank one from
   // here on: M[out][in] += a[out]·(what lane in sees). A later event keeps a and scales the lanes by
@@ -23,7 +23,7 @@ void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch&
     // side keeps the first event's factor a = w·d·Φ·c/(μ̄·mf); a later event's factor scales the in
     // side. The in bin is read off the wavelength, so a later event first closes the segment seen at
     // the previous λin (PathResult::fl_segments): left open, it would be counted in the new λin's bin.
-    float& w0 = s.work.weight[0];
+    float& w0 = weights[0];
     const float event = w0 * density * cache.fl_out[static_cast<std::size_t>(m)] * k;
     if (out.fl_active) out.close_fluorescent_segment(cache.lambda_nm[0]);
     const ExcitationSampler::Draw draw = m_fl_excitation[m].sample(rng.uniform_double());
@@ -42,7 +42,7 @@ void PathTracer::fluoresce(int m, float density, float k, Rng& rng, PathScratch&
     }
     return;
   }
-  const Lanes<0> w = lanes_of<0>(s.work.weight, n);
+  const Lanes<0> w(weights, n);
   const Lanes<0> a = lanes_of<0>(out.fl_a, n);
   const ConstLanes<0> fo = lanes_of<0>(std::as_const(cache.fl_out), n, m);
   const double old_sum = cache.fl_lambda_sum[m];

@@ -11,10 +11,8 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
   // schemes, event_probability.h): P_e ∝ m_e = R_i(w_i σ_e,i) for e ∈ {absorb, scatter, null}, and
   // each lane's weight multiplied by σ_e,i / (μ̄ P_e). With one lane this is analog delta tracking.
   const int n = v.n;
-  const Lanes<kLanes>& w = v.w;
-  const Lanes<kLanes> sa = lanes_of<kLanes>(s.work.sigma_a, n);
-  const Lanes<kLanes> ss = lanes_of<kLanes>(s.work.sigma_s, n);
-  const Lanes<kLanes> sn = lanes_of<kLanes>(s.work.sigma_n, n);
+  LaneArray<kLanes>& w = v.w;
+  LaneArray<kLanes> sa(n), ss(n), sn(n);  // σa, σs, σn at the current collision
   FlightEnd end = FlightEnd::Escaped;
   const Ray ray{v.pos, v.dir};
   sample_majorant(m_grid, ray, v.t_enter, v.t_exit, rng, s.counters.majorant_cells, [&](const TentativeCollision& tc) {
@@ -68,7 +66,7 @@ PathTracer::FlightEnd PathTracer::free_flight(PathState<kLanes>& v, Rng& rng, Pa
       return false;
     }
     if (mf > 0.0f && xi < ma + ms + mf) {
-      fluoresce(m, d, c / (mu * mf), rng, s);
+      fluoresce(m, d, c / (mu * mf), w.data(), rng, s);
       v.env = s.out.fl_environment.data();
       v.em = s.out.fl_emission.data();
       v.dir_out = s.out.fl_directional.data();

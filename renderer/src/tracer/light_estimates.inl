@@ -23,9 +23,8 @@ void PathTracer::estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, boo
   // across lanes, m = v.mix: the weights w under spectral tracking, the lanes' densities ρ under
   // spectral MIS); their escaping paths carry the complementary weight.
   const int n = v.n;
-  const Lanes<kLanes>& w = v.w;
-  const Lanes<kLanes> f = lanes_of<kLanes>(s.work.phase, n);
-  const ConstLanes<kLanes> T = lanes_of<kLanes>(std::as_const(s.work.transmittance), n);
+  const LaneArray<kLanes>& w = v.w;
+  LaneArray<kLanes> f(n), T(n);  // the lanes' phase functions toward the light; the shadow ray's transmittance
   for (std::size_t l = 0; l < m_lights.size(); ++l) {
     LightSample ls;
     if (!m_lights[l].sample(v.pos, rng, ls)) continue;
@@ -33,11 +32,11 @@ void PathTracer::estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, boo
     const auto cos_theta = static_cast<float>(v.dir.dot(wl));
     if constexpr (kLanes == 0) {
       if (v.hero >= 0)  // spectral MIS: the shadow ray at the hero's rates (shadow_mis.inl)
-        transmittance_mis(v.pos, wl, v.mix, v.hero, rng, s, ls.distance);
+        transmittance_mis(v.pos, wl, v.rho, v.hero, T, rng, s, ls.distance);
       else
-        transmittance<kLanes>(v.pos, wl, rng, s, ls.distance);
+        transmittance<kLanes>(v.pos, wl, T, rng, s, ls.distance);
     } else {
-      transmittance<kLanes>(v.pos, wl, rng, s, ls.distance);
+      transmittance<kLanes>(v.pos, wl, T, rng, s, ls.distance);
     }
     const Lanes<kLanes> out = v.lanes(v.dir_out + l * static_cast<std::size_t>(n));
     if (g_constant) {
@@ -50,7 +49,8 @@ void PathTracer::estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, boo
       f = lane_map([cos_theta](float gi) { return hg_phase(cos_theta, gi); }, g);
       double k = ls.value;
       if (ls.pdf > 0.0) {
-        const float total = v.mix.sum(), mix = sum_over(v.mix * f, n);
+        const ConstLanes<kLanes> m = v.mix();
+        const float total = m.sum(), mix = sum_over(m * f, n);
         k *= total > 0.0f ? power_heuristic(ls.pdf, mix / total) : 0.0;
       }
       const auto kf = static_cast<float>(std::min(k, kFloatMax));

@@ -5,8 +5,7 @@
 namespace prizma::render {
 
 template <int kLanes>
-bool PathTracer::sample_phase(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng,
-                              PathScratch& s) const {
+bool PathTracer::sample_phase(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng) const {
   // New direction from the phase function. With g varying across lanes: one-sample MIS over the
   // lanes' lobes with the balance heuristic (Veach 1997, §9.2.4), the lobe chosen in proportion to
   // the lanes' current weights, c_j = w_j / W with W = Σ_j w_j. The direction's density is then
@@ -20,7 +19,7 @@ bool PathTracer::sample_phase(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g
   // mean_j p_j ≤ n per scattering) the factors multiply along the path without bound.
   // False when the path carries nothing any more.
   const int n = v.n;
-  const Lanes<kLanes>& w = v.w;
+  LaneArray<kLanes>& w = v.w;
   float cos_theta;
   if (g_constant) {
     cos_theta = hg_sample_cos(g[0], rng.uniform());
@@ -35,7 +34,7 @@ bool PathTracer::sample_phase(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g
     while (j < n - 1 && cdf <= target) cdf += w[++j];
     while (j > 0 && w[j] <= 0.0f) --j;  // float rounding past the end: the last lane that can be chosen
     cos_theta = hg_sample_cos(g[j], rng.uniform());
-    const Lanes<kLanes> f = lanes_of<kLanes>(s.work.phase, n);
+    LaneArray<kLanes> f(n);
     f = lane_map([cos_theta](float gi) { return hg_phase(cos_theta, gi); }, g);
     const float mix = sum_over(w * f, n);  // Σ_j w_j p_j = W · q(ω)
     if (!(mix > 0.0f)) return false;

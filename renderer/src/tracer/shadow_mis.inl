@@ -21,19 +21,18 @@ namespace prizma::render {
 
 // long on purpose: the depth runs, current cell and roulette are state its segment and collision callbacks share (as transmittance<>).
 void PathTracer::transmittance_mis(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, ConstLanes<0> rho,
-                                   int hero, Rng& rng, PathScratch& s, double t_max) const {
+                                   int hero, Lanes<0> T, Rng& rng, PathScratch& s, double t_max) const {
   // (One function of ~100 lines, as transmittance<> and free_flight_mis: the depth runs, the current
   // cell and the roulette are state that the segment and collision callbacks share.)
   const int n = s.lanes, j = hero;
-  PathWork& pw = s.work;
   MaterialCache& cache = s.cache;
-  const Lanes<0> T = lanes_of<0>(pw.transmittance, n);  // f_i / p_j, renormalised; then the estimate
-  const Lanes<0> tau = lanes_of<0>(pw.optical_depth, n);  // the controls' ∫ σc,i
-  const Lanes<0> P = lanes_of<0>(pw.shadow_pdf, n);      // p_k / p_j, renormalised
-  // The free flight's buffers, idle during the light estimates.
-  const Lanes<0> rate = lanes_of<0>(pw.mis_rate, n), depth = lanes_of<0>(pw.mis_depth, n);
-  const Lanes<0> ratio = lanes_of<0>(pw.mis_ratio, n);
-  const Lanes<0> a = lanes_of<0>(pw.mis_contribution, n), b = lanes_of<0>(pw.mis_factor, n);
+  // T: f_i / p_j, renormalised; then the estimate.
+  LaneArray<0> tau(n);    // the controls' ∫ σc,i
+  LaneArray<0> P(n);      // p_k / p_j, renormalised
+  LaneArray<0> rate(n);   // the lanes' rates μ̄_k in the current cell
+  LaneArray<0> depth(n);  // ∫ μ̄_k since the last point
+  LaneArray<0> ratio(n);  // e^{D_j − D_k}
+  LaneArray<0> a(n), b(n);  // a point's factors on the contributions and the densities
   T = 1.0f;
   P = 1.0f;
   const Ray ray{origin, dir};
@@ -82,7 +81,7 @@ void PathTracer::transmittance_mis(const Eigen::Vector3d& origin, const Eigen::V
   auto depth_ratios = [&]() {
     flush();
     if (any_depth)
-      ratio = lane_map([](float x) { return exp_approx(x); }, depth[j] - ConstLanes<0>(depth));
+      ratio = lane_map([](float x) { return exp_approx(x); }, depth[j] - depth);
     else
       ratio = 1.0f;
     any_depth = false;
@@ -95,7 +94,7 @@ void PathTracer::transmittance_mis(const Eigen::Vector3d& origin, const Eigen::V
       return false;
     }
     const float inv = rho_total / mix;
-    mis_detail::scale_both(n, inv, T.data(), P.data(), a.data(), b.data());  // T, P, a, b: four scratch rows
+    mis_detail::scale_both(n, inv, T.data(), P.data(), a.data(), b.data());  // T, P, a, b: lanes of their own
     return true;
   };
   auto on_segment = [&](const MajorantTraversal::Segment& seg, float& mu) {
@@ -143,7 +142,7 @@ void PathTracer::transmittance_mis(const Eigen::Vector3d& origin, const Eigen::V
     else
       rate = sigma_t_of(mc) * cell_scale;
     residual_at(tc.p, *control, a, s);  // r_i(x) into a
-    a = ratio * lane_max(0.0f, ConstLanes<0>(rate) - ConstLanes<0>(a));
+    a = ratio * lane_max(0.0f, rate - a);
     b = ratio * rate;
     if (!update()) return false;
     return transmittance_roulette(T, tau_min + run_tau * run_sigma_min, rng);
@@ -154,7 +153,7 @@ void PathTracer::transmittance_mis(const Eigen::Vector3d& origin, const Eigen::V
   a = ratio;
   b = ratio;
   if (!update()) return;
-  if (any_tau) T *= lane_map([](float x) { return std::exp(-x); }, ConstLanes<0>(tau));
+  if (any_tau) T *= lane_map([](float x) { return std::exp(-x); }, tau);
 }
 
 void PathTracer::estimate_transmittance_mis(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
@@ -162,7 +161,9 @@ void PathTracer::estimate_transmittance_mis(const Eigen::Vector3d& origin, const
   MaterialCache& cache = s.cache;
   std::copy(s.in.lambda_nm.begin(), s.in.lambda_nm.end(), cache.lambda_nm.begin());
   cache.new_wavelengths();
-  transmittance_mis(origin, dir, ConstLanes<0>(rho.data(), s.lanes), hero, rng, s, t_max);
+  const int n = s.lanes;
+  transmittance_mis(origin, dir, ConstLanes<0>(rho.data(), n), hero, lanes_of<0>(s.work.transmittance, n), rng, s,
+                    t_max);
 }
 
 void PathTracer::residual_at(const Eigen::Vector3d& p, const CellControl& control, Lanes<0> r, PathScratch& s) const {

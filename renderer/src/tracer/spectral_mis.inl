@@ -66,10 +66,10 @@ inline void scale_both(int n, float inv, float* __restrict x, float* __restrict 
 
 bool PathTracer::mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) const {
   const int n = v.n;
-  const Lanes<0>& rho = v.mix;
+  LaneArray<0>& rho = v.rho;
   // Σ ρ and Σ ρ b in one pass, w and ρ in another (the same bits as two partial::sum calls and
-  // `w *= a * inv; ρ *= b * inv`, in half the passes over the lanes). a and b are scratch rows, never
-  // w or ρ (they may be the same row as each other: both are only read).
+  // `w *= a * inv; ρ *= b * inv`, in half the passes over the lanes). a and b are lanes of their own,
+  // never w or ρ (they may be the same lanes as each other: both are only read).
   float total, mix;
   mis_detail::sum2(rho.view(), rho * b, n, total, mix);
   if (!(mix > 0.0f) || !(total > 0.0f) || !std::isfinite(mix)) return false;  // no lane can go on
@@ -89,11 +89,10 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
   // its depth is the same for all lanes. (One function of ~90 lines: the depth runs and the current
   // cell are state that the segment and collision callbacks share; the collision is collide_mis.)
   const int n = v.n, j = v.hero;
-  PathWork& pw = s.work;
   MaterialCache& cache = s.cache;
-  const Lanes<0> rate = lanes_of<0>(pw.mis_rate, n);    // μ̄_k of the current cell
-  const Lanes<0> depth = lanes_of<0>(pw.mis_depth, n);  // ∫ μ̄_k over bound cells since the last collision
-  const Lanes<0> ratio = lanes_of<0>(pw.mis_ratio, n);  // T_k / T_j at a collision
+  LaneArray<0> rate(n);   // μ̄_k of the current cell
+  LaneArray<0> depth(n);  // ∫ μ̄_k over bound cells since the last collision
+  LaneArray<0> ratio(n);  // T_k / T_j at a collision
   auto sigma_t_of = [&](std::uint16_t m) { return lanes_of<0>(std::as_const(cache.sigma_t), n, m); };
 
   // Runs of bound cells of one material m add up the scalar Σ d_max·ℓ, put on the lanes as that
@@ -165,8 +164,7 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
     }
     count_to(tc.t);
     transmittance_ratios();
-    // The lanes' majorants, once per cell (the light estimates, which borrow the buffer, run only
-    // between free flights).
+    // The lanes' majorants, once per cell.
     if (!rate_set) {
       if (cell.material != CellSpectralBound::kNone)
         rate = sigma_t_of(cell.material) * cell.density_max;
@@ -174,7 +172,7 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
         rate = tc.mu;
       rate_set = true;
     }
-    return collide_mis(v, tc, end, rng, s);
+    return collide_mis(v, tc, rate, ratio, end, rng, s);
   });
   if (!reached) return end;
   // Escaped: no collision up to the exit, density T_k for technique k, contribution T_i.
@@ -183,19 +181,17 @@ PathTracer::FlightEnd PathTracer::free_flight_mis(PathState<0>& v, Rng& rng, Pat
   return mis_update(v, ratio, ratio) ? FlightEnd::Escaped : FlightEnd::Absorbed;
 }
 
-bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, FlightEnd& end, Rng& rng,
-                             PathScratch& s) const {
-  // A tentative collision of the hero's free flight (free_flight_mis has put the transmittance ratios
-  // T_k/T_j and the lanes' majorants μ̄_k of its cell into work.mis_ratio and work.mis_rate): the
-  // emission layer, then the hero's event and every lane's update. True: a null collision, the walk
-  // goes on; false with `end` Absorbed or Scattered (v.pos, v.material set).
+bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, ConstLanes<0> rate, ConstLanes<0> ratio,
+                             FlightEnd& end, Rng& rng, PathScratch& s) const {
+  // A tentative collision of the hero's free flight, with the transmittance ratios T_k/T_j since the
+  // last one and the lanes' majorants μ̄_k of its cell (free_flight_mis's): the emission layer, then
+  // the hero's event and every lane's update. True: a null collision, the walk goes on; false with
+  // `end` Absorbed or Scattered (v.pos, v.material set).
   const int n = v.n, j = v.hero;
-  PathWork& pw = s.work;
   MaterialCache& cache = s.cache;
-  const Lanes<0>& w = v.w;
-  const Lanes<0> sa = lanes_of<0>(pw.sigma_a, n), ss = lanes_of<0>(pw.sigma_s, n), sn = lanes_of<0>(pw.sigma_n, n);
-  const Lanes<0> rate = lanes_of<0>(pw.mis_rate, n), ratio = lanes_of<0>(pw.mis_ratio, n);
-  const Lanes<0> b = lanes_of<0>(pw.mis_factor, n);
+  const LaneArray<0>& w = v.w;
+  LaneArray<0> sa(n), ss(n), sn(n);  // σa, σs, σn at the lanes' own majorants
+  LaneArray<0> b(n);                 // the event's factors on the densities
   std::uint16_t m;
   float d;
   lookup(tc.p, m, d);
@@ -215,7 +211,7 @@ bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, Flig
   if (m_emits[m]) {
     // Emission at every tentative collision (pbrt-v4's estimator): lane i's ∫ T_i σa,i Le,i ds
     // sampled at density Σ_k c_k p_k μ̄_k T_k.
-    const float total = partial::sum(v.mix, n), mix = partial::sum(v.mix * ratio * rate, n);
+    const float total = partial::sum(v.rho, n), mix = partial::sum(v.rho * ratio * rate, n);
     if (mix > 0.0f)
       v.lanes(v.em) += w * ratio * sa * lanes_of<0>(std::as_const(cache.emission_le), n, m) * (total / mix);
   }
@@ -239,8 +235,8 @@ bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, Flig
     // b_k = T_k μ̄_k P_e,k; a_i / b_i = (σs,i + σn,i)/μ̄_i is lane i's survival.
     const float cj = ss[j] + sn[j];
     scatter = cj > 0.0f ? rng.uniform() * cj < ss[j] : true;
-    const Lanes<0> a = lanes_of<0>(pw.mis_contribution, n);
-    const Lanes<0>& coef = scatter ? ss : sn;
+    LaneArray<0> a(n);  // the event's factors on the contributions
+    const LaneArray<0>& coef = scatter ? ss : sn;
     a = ratio * coef;
     const float none = scatter ? 1.0f : 0.0f;
     {  // (restrict pointers and a division by 1 where ck is 0, so that the loop vectorises)
@@ -270,16 +266,16 @@ bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, Flig
 
 }
 
-bool PathTracer::sample_phase_hero(PathState<0>& v, ConstLanes<0> g, bool g_constant, Rng& rng, PathScratch& s) const {
+bool PathTracer::sample_phase_hero(PathState<0>& v, ConstLanes<0> g, bool g_constant, Rng& rng) const {
   // The hero's lobe: cos θ from p_j, then w_i ← w_i p_i / q and ρ_k ← ρ_k p_k / q with
   // q = Σ_k ρ_k p_k / Σ_k ρ_k, the density of the direction over the lanes' techniques given the
   // path so far (what escaping paths weigh environment maps' MIS with; estimate_lights the same).
-  if (g_constant) return sample_phase(v, g, g_constant, rng, s);
+  if (g_constant) return sample_phase(v, g, g_constant, rng);
   const int n = v.n;
   const float cos_theta = hg_sample_cos(g[v.hero], rng.uniform());
-  const Lanes<0> f = lanes_of<0>(s.work.phase, n);
+  LaneArray<0> f(n);
   f = lane_map([cos_theta](float gi) { return hg_phase(cos_theta, gi); }, g);
-  const float total = partial::sum(v.mix, n), mix = partial::sum(v.mix * f, n);
+  const float total = partial::sum(v.rho, n), mix = partial::sum(v.rho * f, n);
   if (!mis_update(v, f, f)) return false;
   v.phase_pdf = mix / total;
   v.dir = direction_around(v.dir, cos_theta, rng.uniform_double()).normalized();

@@ -6,8 +6,8 @@ namespace prizma::render {
 
 // long on purpose: residual ratio tracking: the control runs, roulette and depth are state the segment and collision callbacks share.
 template <int kLanes>
-void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng,
-                               PathScratch& s, double t_max) const {
+void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Lanes<kLanes> T,
+                               Rng& rng, PathScratch& s, double t_max) const {
   // Residual ratio tracking (Novák, Georgiev, Hanika, Jarosz 2014) against the cells' controls,
   // every lane at once: T = exp(−∫ σc ds) · Π (1 − (σt − σc)/μ̄r) over tentative collisions at the
   // residual rate μ̄r, with Russian roulette at the steps once T is small. A cell without a
@@ -15,8 +15,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
   // cell (μ̄r = 0) takes no steps. The controls' optical depth τ is summed per lane and applied
   // once at the end.
   const int n = lane_count<kLanes>(s);
-  const Lanes<kLanes> T = lanes_of<kLanes>(s.work.transmittance, n);
-  const Lanes<kLanes> tau = lanes_of<kLanes>(s.work.optical_depth, n);
+  LaneArray<kLanes> tau(n);  // the controls' optical depth (written by the first flush)
   T = 1.0f;
   const Ray ray{origin, dir};
   double t_enter, t_exit;
@@ -41,7 +40,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
     else
       tau = sigma_t * run_depth;
     any_control = true;
-    tau_min = partial::min_from_infinity(tau, n);
+    tau_min = partial::min_from_infinity(tau.view(), n);
     run_depth = 0.0f;
   };
   float t_res_max = 1.0f;  // the largest lane of T (the residual product)
@@ -113,7 +112,7 @@ void PathTracer::transmittance(const Eigen::Vector3d& origin, const Eigen::Vecto
   });
   if (!reached) return;
   flush();
-  if (any_control) T *= lane_map([](float x) { return std::exp(-x); }, ConstLanes<kLanes>(tau));
+  if (any_control) T *= lane_map([](float x) { return std::exp(-x); }, tau);
 }
 
 void PathTracer::estimate_transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
@@ -122,9 +121,9 @@ void PathTracer::estimate_transmittance(const Eigen::Vector3d& origin, const Eig
   std::copy(s.in.lambda_nm.begin(), s.in.lambda_nm.end(), cache.lambda_nm.begin());
   cache.new_wavelengths();
   if (s.lanes == 1)
-    transmittance<1>(origin, dir, rng, s, t_max);
+    transmittance<1>(origin, dir, lanes_of<1>(s.work.transmittance, 1), rng, s, t_max);
   else
-    transmittance<0>(origin, dir, rng, s, t_max);
+    transmittance<0>(origin, dir, lanes_of<0>(s.work.transmittance, s.lanes), rng, s, t_max);
 }
 
 }  // namespace prizma::render

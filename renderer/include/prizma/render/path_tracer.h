@@ -37,7 +37,9 @@ struct PathCounters {
 
 // Per-thread working memory of the tracer, sized once by PathTracer::prepare for n lanes and the
 // scene's materials, in four parts: what the caller sets (in), what the tracer caches per path
-// (cache), its temporaries (work) and what a path returns (out); plus counters.
+// (cache), a few per-lane arrays (work) and what a path returns (out); plus counters. A path's own
+// per-lane state (weights, densities, transmittances) is not here: it is LaneArray values
+// (renderer/src/lanes.h) on the stack.
 struct PathInputs {
   std::vector<float> lambda_nm;  // [lanes] the path's wavelengths, set before every trace()
   // Fluorescence (docs/fluorescence.md; used only when a material fluoresces): each lane's bin,
@@ -46,7 +48,7 @@ struct PathInputs {
   std::vector<float> lo_nm;     // [lanes]
   std::vector<float> width_nm;  // [lanes]
   // Spectral MIS (WavelengthSampling::SpectralMis): the lane the path is sampled for, set before
-  // every trace() (WavelengthMap::hero_lane: a stratified draw over the bins).
+  // every trace() (WavelengthMap::draw's hero: a stratified draw over the bins).
   int hero_lane = 0;
 };
 
@@ -76,21 +78,11 @@ struct MaterialCache {
   std::vector<float> fl_in;           // [material][lanes] p_j = Δj·σf(λj)·λj / Λ
 };
 
-// Temporaries of one path, meaningless between calls.
+// What the tracer keeps per thread besides the cache and the results (a path's own per-lane state,
+// its weights, densities and a shadow ray's transmittance, lives in LaneArray values on the stack).
 struct PathWork {
-  std::vector<float> weight;         // [lanes] path throughput
-  std::vector<float> transmittance;  // [lanes] ratio tracking
-  std::vector<float> optical_depth;  // [lanes] ratio tracking: the controls' ∫ σc ds
-  std::vector<float> phase;          // [lanes]
-  std::vector<float> sigma_a, sigma_s, sigma_n;  // [lanes] at the current collision
+  std::vector<float> transmittance;  // [lanes] estimate_transmittance(_mis)'s result
   std::vector<float> zero_g;         // [lanes] g = 0: fluorescence's isotropic re-emission
-  // Spectral MIS (renderer/src/tracer/spectral_mis.inl), [lanes] each: the lanes' normalised path
-  // densities ρ, the current cell's per-lane majorants, their optical depths since the last
-  // collision, the transmittance ratios T_k/T_j, and an event's factors on densities and contributions.
-  std::vector<float> mis_pdf, mis_rate, mis_depth, mis_ratio, mis_factor, mis_contribution;
-  // Spectral MIS for shadow rays (renderer/src/tracer/shadow_mis.inl): the lanes' shadow-ray densities
-  // over the hero's, renormalised.
-  std::vector<float> shadow_pdf;
 };
 
 // What trace() returns per lane (overwritten by every path): radiance at unit white.
@@ -195,23 +187,25 @@ class PathTracer {
   // Spectral MIS: the hero's free flight, its phase lobe, and the update of the lanes' weights and
   // densities by an event's factors a (contributions) and b (densities); false when nothing is left.
   FlightEnd free_flight_mis(PathState<0>& v, Rng& rng, PathScratch& s) const;
-  bool collide_mis(PathState<0>& v, const TentativeCollision& tc, FlightEnd& end, Rng& rng, PathScratch& s) const;
-  bool sample_phase_hero(PathState<0>& v, ConstLanes<0> g, bool g_constant, Rng& rng, PathScratch& s) const;
+  // (rate: the lanes' majorants μ̄_k of the collision's cell, ratio: the transmittance ratios T_k/T_j.)
+  bool collide_mis(PathState<0>& v, const TentativeCollision& tc, ConstLanes<0> rate, ConstLanes<0> ratio,
+                   FlightEnd& end, Rng& rng, PathScratch& s) const;
+  bool sample_phase_hero(PathState<0>& v, ConstLanes<0> g, bool g_constant, Rng& rng) const;
   bool mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) const;
   template <int kLanes>
   void estimate_lights(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng, PathScratch& s) const;
   template <int kLanes>
-  bool sample_phase(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng, PathScratch& s) const;
+  bool sample_phase(PathState<kLanes>& v, ConstLanes<kLanes> g, bool g_constant, Rng& rng) const;
   template <int kLanes>
   bool roulette(PathState<kLanes>& v, Rng& rng) const;
-  // Transmittance from origin along dir up to t_max, per lane, into s.work.transmittance.
+  // Transmittance from origin along dir up to t_max, per lane, into T.
   template <int kLanes>
-  void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Rng& rng, PathScratch& s,
-                     double t_max = std::numeric_limits<double>::infinity()) const;
+  void transmittance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, Lanes<kLanes> T, Rng& rng,
+                     PathScratch& s, double t_max = std::numeric_limits<double>::infinity()) const;
   // Spectral MIS's: residual ratio tracking at the hero lane's own rates, every lane weighted by the
   // balance heuristic over the lanes with the path's normalised densities rho (shadow_mis.inl).
   void transmittance_mis(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, ConstLanes<0> rho, int hero,
-                         Rng& rng, PathScratch& s, double t_max) const;
+                         Lanes<0> T, Rng& rng, PathScratch& s, double t_max) const;
   // σt,i(p) − σc,i per lane into r: the medium at p less the cell's control.
   void residual_at(const Eigen::Vector3d& p, const CellControl& control, Lanes<0> r, PathScratch& s) const;
   // Ratio tracking's Russian roulette on T with depth_lo a lower bound of the depth still to apply;
@@ -225,7 +219,8 @@ class PathTracer {
                   PathScratch& s) const;
   void evaluate_material(int m, PathScratch& s) const;
   void evaluate_fluorescence(int m, PathScratch& s) const;
-  void fluoresce(int m, float density, float k, Rng& rng, PathScratch& s) const;
+  // The fluorescent event at material m (w: the path's weights, s.lanes of them, changed in place).
+  void fluoresce(int m, float density, float k, float* w, Rng& rng, PathScratch& s) const;
   // Trilinear: the raw value at p (NaN when a contributing voxel is not finite), and its class.
   float interpolate(const Eigen::Vector3d& p) const;
   void classify(float value, std::uint16_t& material, float& density) const;

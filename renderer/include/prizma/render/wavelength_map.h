@@ -1,8 +1,10 @@
 #pragma once
-// WavelengthMap: how a sample's path lanes map to the render's bins (docs/renderer.md,
-// "Wavelengths"). AllBins: one lane per bin, λ_i = lo_i + u·Δλ_i with one jitter u for all bins
-// (spectral tracking); Replicated: one lane at the first bin's centre, copied to every bin (a
-// wavelength-independent medium); Single: VPT's method, one bin drawn per path, its lane × n into it.
+// WavelengthMap: the wavelength sampler, how a sample's path lanes are drawn and map to the render's
+// bins (docs/renderer.md, "Wavelengths"). AllBins: one lane per bin, λ_i = lo_i + u·Δλ_i with one
+// jitter u for all bins (spectral tracking), and under spectral MIS a hero lane per sample;
+// Replicated: one lane at the first bin's centre, copied to every bin (a wavelength-independent
+// medium); Single: VPT's method, one bin drawn per path, its lane × n into it. A mode is draw()
+// (the lanes' wavelengths and the hero) and to_bins() (the lanes' values into the bins).
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -14,24 +16,37 @@ namespace prizma::render {
 
 enum class LaneMode { AllBins, Replicated, Single };
 
-// What one sample drew: the jitter shared by every bin, and Single's bin.
+// What one sample drew: the jitter shared by every bin, Single's bin, and spectral MIS's hero lane.
 struct WavelengthDraw {
   double u = 0.0;
   int bin = 0;
+  int hero = -1;  // the lane the path is sampled for (hero_lane); −1: none (no spectral MIS)
+};
+
+// Which sample of the render a draw is for (the hero lane is a function of it).
+struct SampleIndex {
+  std::uint64_t seed = 0;
+  std::uint64_t pixel = 0;
+  std::int64_t sample = 0;
 };
 
 class WavelengthMap {
  public:
-  WavelengthMap(LaneMode mode, const spectral::BinLayout& bins)
-      : m_mode(mode), m_bins(bins), m_hero_order(van_der_corput_order(lanes())) {}
+  // hero: spectral MIS (WavelengthSampling::SpectralMis), each draw also picks the sample's hero
+  // lane; only with several lanes (AllBins).
+  WavelengthMap(LaneMode mode, const spectral::BinLayout& bins, bool hero = false)
+      : m_mode(mode), m_bins(bins), m_hero(hero && mode == LaneMode::AllBins),
+        m_hero_order(van_der_corput_order(lanes())) {}
 
   LaneMode mode() const { return m_mode; }
+  bool has_hero() const { return m_hero; }
   int lanes() const { return m_mode == LaneMode::AllBins ? m_bins.size() : 1; }
 
   // Draws the sample's wavelengths into lambda_nm[lanes()] (u, then Single's bin: the stream's
-  // order is part of the output).
-  WavelengthDraw draw(Rng& rng, float* lambda_nm) const {
+  // order is part of the output) and, under spectral MIS, its hero lane hero_lane(at).
+  WavelengthDraw draw(Rng& rng, float* lambda_nm, const SampleIndex& at) const {
     WavelengthDraw d;
+    if (m_hero) d.hero = hero_lane(at.seed, at.pixel, at.sample);
     d.u = rng.uniform_double();
     const int nb = m_bins.size();
     switch (m_mode) {
@@ -104,6 +119,7 @@ class WavelengthMap {
 
   LaneMode m_mode;
   spectral::BinLayout m_bins;
+  bool m_hero;
   std::vector<int> m_hero_order;  // hero_lane's π
 };
 
