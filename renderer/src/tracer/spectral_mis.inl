@@ -62,6 +62,19 @@ inline void scale_both(int n, float inv, float* __restrict x, float* __restrict 
   }
 }
 
+// Implicit capture's density factors b_k = T_k μ̄_k P_e,k, with P_e,k = coef_k / (σs,k + σn,k) and
+// `none` (1 for a scattering, 0 for a null event) where both are 0. Restrict pointers and a division by
+// 1 where the sum is 0, so that GCC vectorises the loop.
+inline void implicit_densities(int n, float none, const float* __restrict ratio, const float* __restrict mu,
+                               const float* __restrict coef, const float* __restrict ss,
+                               const float* __restrict sn, float* __restrict b) {
+  for (int k = 0; k < n; ++k) {
+    const float ck = ss[k] + sn[k];
+    const float q = coef[k] / (ck > 0.0f ? ck : 1.0f);
+    b[k] = ratio[k] * mu[k] * (ck > 0.0f ? q : none);
+  }
+}
+
 }  // namespace mis_detail
 
 bool PathTracer::mis_update(PathState<0>& v, ConstLanes<0> a, ConstLanes<0> b) const {
@@ -238,20 +251,8 @@ bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, Cons
     LaneArray<0> a(n);  // the event's factors on the contributions
     const LaneArray<0>& coef = scatter ? ss : sn;
     a = ratio * coef;
-    const float none = scatter ? 1.0f : 0.0f;
-    {  // (restrict pointers and a division by 1 where ck is 0, so that the loop vectorises)
-      const float* __restrict pr = ratio.data();
-      const float* __restrict pm = rate.data();
-      const float* __restrict pc = coef.data();
-      const float* __restrict pss = ss.data();
-      const float* __restrict psn = sn.data();
-      float* __restrict pb = b.data();
-      for (int k = 0; k < n; ++k) {
-        const float ck = pss[k] + psn[k];
-        const float q = pc[k] / (ck > 0.0f ? ck : 1.0f);
-        pb[k] = pr[k] * pm[k] * (ck > 0.0f ? q : none);
-      }
-    }
+    mis_detail::implicit_densities(n, scatter ? 1.0f : 0.0f, ratio.data(), rate.data(), coef.data(), ss.data(),
+                                   sn.data(), b.data());
     if (!mis_update(v, a, b)) {
       end = FlightEnd::Absorbed;
       return false;
@@ -263,7 +264,6 @@ bool PathTracer::collide_mis(PathState<0>& v, const TentativeCollision& tc, Cons
   v.isotropic = false;
   end = FlightEnd::Scattered;
   return false;
-
 }
 
 bool PathTracer::sample_phase_hero(PathState<0>& v, ConstLanes<0> g, bool g_constant, Rng& rng) const {
