@@ -47,11 +47,11 @@ TEST(Lanes, LaneArrayChecksItsSizeAgainstItsCapacity) {
   static_assert(LaneArray<0>::kCapacity == spectral::BinLayout::kMaxBins);
   static_assert(LaneArray<1>::kCapacity == 1);
   static_assert(alignof(LaneArray<0>) == 64);
-  EXPECT_NO_THROW(LaneArray<0>(spectral::BinLayout::kMaxBins));
-  EXPECT_NO_THROW(LaneArray<0>(0));
-  EXPECT_THROW(LaneArray<0>(spectral::BinLayout::kMaxBins + 1), std::length_error);
-  EXPECT_THROW(LaneArray<0>(-1), std::length_error);
-  EXPECT_THROW(LaneArray<1>(2), std::length_error);
+  EXPECT_NO_THROW(static_cast<void>(LaneArray<0>(spectral::BinLayout::kMaxBins)));
+  EXPECT_NO_THROW(static_cast<void>(LaneArray<0>(0)));
+  EXPECT_THROW(static_cast<void>(LaneArray<0>(spectral::BinLayout::kMaxBins + 1)), std::length_error);
+  EXPECT_THROW(static_cast<void>(LaneArray<0>(-1)), std::length_error);
+  EXPECT_THROW(static_cast<void>(LaneArray<1>(2)), std::length_error);
   EXPECT_EQ(LaneArray<1>(1, 2.0f).size(), 1);
   const LaneArray<0> filled(3, 0.25f);
   EXPECT_EQ(filled.size(), 3);
