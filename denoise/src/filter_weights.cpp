@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <tbb/parallel_for.h>
 
@@ -226,22 +227,21 @@ void regress_tile(const std::vector<int>& exact, const std::vector<double>& exac
   const int n = 2 * r + 1, twp = detail::padded(rect.width), f_cols = twp + 2 * r;
   const std::size_t plane = static_cast<std::size_t>(rect.height) * twp;
   Eigen::MatrixXd a(m + 1, m + 1);
-  Eigen::VectorXd x(m + 1);
+  // x_q of each neighbour with a weight, gathered once for the fit and for the hat matrix's row.
+  std::vector<Eigen::VectorXd> xs(static_cast<std::size_t>(n) * n, Eigen::VectorXd(m + 1));
   for (int y = 0; y < rect.height; ++y)
     for (int px = 0; px < rect.width; ++px) {
       const std::size_t t = static_cast<std::size_t>(y) * twp + px;
       const std::size_t centre = static_cast<std::size_t>(y + r) * f_cols + px + r;
-      auto features_at = [&](int o) {
-        const std::size_t q = centre + static_cast<std::ptrdiff_t>(o / n - r) * f_cols + (o % n - r);
-        x[0] = 1.0;
-        for (int k = 0; k < m; ++k)
-          x[k + 1] = exact_scale[k] * (static_cast<double>(s.feature_value[exact[k]][q]) - s.feature_value[exact[k]][centre]);
-      };
       a.setZero();
       for (int o = 0; o < n * n; ++o) {
         const double w = s.weights[candidate][o * plane + t];
         if (w == 0.0) continue;
-        features_at(o);
+        Eigen::VectorXd& x = xs[static_cast<std::size_t>(o)];
+        const std::size_t q = centre + static_cast<std::ptrdiff_t>(o / n - r) * f_cols + (o % n - r);
+        x[0] = 1.0;
+        for (int k = 0; k < m; ++k)
+          x[k + 1] = exact_scale[k] * (static_cast<double>(s.feature_value[exact[k]][q]) - s.feature_value[exact[k]][centre]);
         a.selfadjointView<Eigen::Lower>().rankUpdate(x, w);  // the lower triangle, which ldlt() reads
       }
       // Ridge: λ times each feature's weighted variance over the kernel (a(0, 0) = Σw = 1), so
@@ -252,8 +252,7 @@ void regress_tile(const std::vector<int>& exact, const std::vector<double>& exac
       for (int o = 0; o < n * n; ++o) {
         float& w = s.weights[candidate][o * plane + t];
         if (w == 0.0f) continue;
-        features_at(o);
-        w = static_cast<float>(w * x.dot(c));
+        w = static_cast<float>(w * xs[static_cast<std::size_t>(o)].dot(c));
       }
     }
 }
@@ -403,20 +402,17 @@ FilterWeights compute_weights(DenoiseGuides&& guides, const DenoiseOptions& opti
   prefilter_features(guides, options);
   auto derived = std::make_shared<FilterWeights::Derived>();
   derived->eps = distance_epsilon(guides.luminance);
-  for (const GuidePlane& p : guides.features) {
+  for (std::size_t k = 0; k < guides.features.size(); ++k) {
+    const GuidePlane& p = guides.features[k];
     const auto [lo, hi] = std::minmax_element(p.value.begin(), p.value.end());
     const double range = static_cast<double>(*hi) - *lo;
     derived->feature_tau.push_back(
         static_cast<float>(options.feature_tau * range * range) + std::numeric_limits<float>::min());
-  }
-    for (std::size_t k = 0; k < guides.features.size(); ++k) {
-      const GuidePlane& p = guides.features[k];
-      if (!p.exact) continue;
-      const auto [lo, hi] = std::minmax_element(p.value.begin(), p.value.end());
-      const double range = static_cast<double>(*hi) - *lo;
+    if (p.exact) {  // regressed on, scaled by 1 / its range (1 for a constant plane)
       derived->exact.push_back(static_cast<int>(k));
       derived->exact_scale.push_back(range > 0.0 ? 1.0 / range : 1.0);
     }
+  }
   if (options.patch_k_wide > 0.0f && options.patch_k_wide != options.patch_k)
     derived->inv_k2 = choose_inv_k2({guides, options, derived->eps, derived->feature_tau});
   FilterWeights w;

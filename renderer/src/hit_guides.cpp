@@ -7,9 +7,9 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
-#include <limits>
 #include <utility>
 
+#include "prizma/render/majorant_grid.h"
 #include "prizma/render/path_tracer.h"
 #include "prizma/spectral/colour_matching.h"
 
@@ -87,20 +87,10 @@ struct Marcher {
     return m == Medium::kEmpty ? 0.0 : ref.sigma_t[m] * d;
   }
 
-  // [t0, t1): the ray's span inside the bounds (empty when t0 ≥ t1).
+  // [t0, t1): the ray's span inside the bounds ({0, 0} when it misses them).
   std::pair<double, double> span(const Ray& ray) const {
-    double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
-    for (int a = 0; a < 3; ++a) {
-      const double inv = 1.0 / ray.direction[a];
-      double ta = (medium.bounds_min[a] - ray.origin[a]) * inv, tb = (medium.bounds_max[a] - ray.origin[a]) * inv;
-      if (std::isnan(ta) || std::isnan(tb)) {  // parallel to the slab, on its plane
-        if (ray.origin[a] < medium.bounds_min[a] || ray.origin[a] > medium.bounds_max[a]) return {0.0, 0.0};
-        continue;
-      }
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-    }
+    double t0 = 0.0, t1 = 0.0;
+    if (!intersect_box(ray, medium.bounds_min, medium.bounds_max, t0, t1)) return {0.0, 0.0};
     return {t0, t1};
   }
 
