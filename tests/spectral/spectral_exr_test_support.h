@@ -4,7 +4,6 @@
 // rewrites.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <ImfChannelList.h>
 #include <ImfFloatVectorAttribute.h>
@@ -40,6 +39,7 @@
 
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectral_exr.h"
+#include "scratch_files.h"
 
 namespace prizma::spectral::exr_test {
 
@@ -48,10 +48,7 @@ namespace fs = std::filesystem;
 class SpectralExr : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    m_dir = fs::temp_directory_path() / ("prizma-test-exr-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::remove_all(m_dir);
-    fs::create_directories(m_dir);
+    m_dir = test::scratch_dir("exr", ::testing::UnitTest::GetInstance()->current_test_info()->name());
   }
   void TearDown() override { fs::remove_all(m_dir); }
   fs::path file(const std::string& name) const { return m_dir / name; }

@@ -11,7 +11,6 @@
 #include <ImfStringAttribute.h>
 #include <gtest/gtest.h>
 #include <half.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -22,6 +21,7 @@
 #include "prizma/spectral/error.h"
 #include "prizma/spectral/spectral_basis.h"
 #include "prizma/spectral/spectral_exr.h"
+#include "scratch_files.h"
 
 namespace prizma::spectral {
 namespace {
@@ -31,9 +31,7 @@ namespace fs = std::filesystem;
 class CoefficientsExr : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    m_dir = fs::temp_directory_path() / ("prizma-test-coef-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::create_directories(m_dir);
+    m_dir = test::scratch_dir("coef", ::testing::UnitTest::GetInstance()->current_test_info()->name());
   }
   void TearDown() override { fs::remove_all(m_dir); }
   fs::path file(const std::string& name) const { return m_dir / name; }
