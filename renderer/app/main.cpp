@@ -368,8 +368,10 @@ void print_scene(const render::Scene& scene) {
             << scene.camera.width << "×" << scene.camera.height << ", " << st.bins.size() << " bins "
             << st.bins.to_string() << ", samples " << st.sample_begin << ":" << st.sample_end << ", seed "
             << st.seed << ", " << render::wavelength_sampling_name(render::resolve_wavelength_sampling(scene))
-            << (st.wavelength_sampling == render::WavelengthSampling::Auto ? " (auto)" : "") << ", "
-            << render::sampler_name(st.sampler) << " sampler"
+            << (st.wavelength_sampling == render::WavelengthSampling::Auto ? " (auto)" : "");
+  if (const int groups = render::resolve_mis_lane_groups(scene); groups > 1)
+    std::cerr << " in " << groups << " lane groups" << (st.mis_lane_groups == 0 ? " (auto)" : "");
+  std::cerr << ", " << render::sampler_name(st.sampler) << " sampler"
             << (st.use_majorant_grid ? ", majorant grid" : ", global majorant") << "\n";
   std::cerr << kProgram << ": event probabilities ("
             << render::event_probabilities_name(st.event_probabilities) << "): "

@@ -107,34 +107,43 @@ class PixelRenderer {
       const double py = y + rng.uniform_double();
       const Ray ray = m_c.camera.generate(px, py);
       const SampleIndex at{.seed = st.seed, .pixel = pix, .sample = s};
-      const WavelengthDraw draw = m_c.map.draw(rng, ps.in.lambda_nm.data(), at);
-      if (draw.hero >= 0) ps.in.hero_lane = draw.hero;
-      m_c.tracer.trace(ray, rng, ps);
-      ++ts.paths;
-
-      // Lanes → (light, bin) values of this sample.
+      // One path per lane group (one path without groups), all from the same camera ray.
       bool finite = true;
-      for (int l = 0; l < nl; ++l) {
-        double* out = v + static_cast<std::size_t>(l) * nb;
-        m_c.map.to_bins(lane_values(ps.out, l, false), draw, out);
-        if constexpr (Fold::kFolds) {
-          if (m_c.map.mode() == LaneMode::Single) {
-            out[draw.bin] *= m_fold.at(l, m_c.map.lambda_at(draw, draw.bin));
-          } else {
-            for (int i = 0; i < nb; ++i) out[i] *= m_fold.at(l, m_c.map.lambda_at(draw, i));
+      double guides[2];
+      const int groups = m_c.map.groups();
+      for (int k = 0; k < groups; ++k) {
+        const WavelengthDraw draw = m_c.map.draw(rng, ps.in.lambda_nm.data(), at, k);
+        if (draw.hero >= 0) ps.in.hero_lane = draw.hero;
+        ps.lanes = draw.lanes;  // a lane group's: fewer than prepared
+        m_c.tracer.trace(ray, rng, ps);
+        ++ts.paths;
+
+        // Lanes → (light, bin) values of this sample (with lane groups: the group's bins).
+        const auto [b0, b1] = m_c.map.bin_range(draw);
+        for (int l = 0; l < nl; ++l) {
+          double* out = v + static_cast<std::size_t>(l) * nb;
+          m_c.map.to_bins(lane_values(ps.out, l, false, draw.lanes), draw, out);
+          if constexpr (Fold::kFolds) {
+            if (m_c.map.mode() == LaneMode::Single) {
+              out[draw.bin] *= m_fold.at(l, m_c.map.lambda_at(draw, draw.bin));
+            } else {
+              for (int i = b0; i < b1; ++i) out[i] *= m_fold.at(l, m_c.map.lambda_at(draw, i));
+            }
           }
+          for (int i = b0; i < b1; ++i) finite = finite && std::isfinite(out[i]);
         }
-        for (int i = 0; i < nb; ++i) finite = finite && std::isfinite(out[i]);
+        if (m_c.fluorescent) finite = add_fluorescent_sample(ps, draw.bin, v, ts.value_fl.data()) && finite;
+        // The guides from the first path: it starts at the sample's first random numbers, so what it
+        // sees before its first event does not depend on the lights (the later groups' paths start
+        // after the earlier ones' light estimates).
+        if (k == 0) guide_sample(ps.out, guides);
       }
-      if (m_c.fluorescent) finite = add_fluorescent_sample(ps, draw.bin, v, ts.value_fl.data()) && finite;
       if (!finite) {
         // Never let a NaN/Inf reach the image: count it, take the sample as 0.
         ++ts.nan_or_inf;
         std::fill(v, v + per_pixel, 0.0);
         std::fill(ts.value_fl.begin(), ts.value_fl.end(), 0.0);
       }
-      double guides[2];
-      guide_sample(ps.out, guides);
       if (m_c.film.add_sample(pix, v, ts.value_fl.data(), guides)) {
         ++ts.converged;
         return;
@@ -153,11 +162,12 @@ class PixelRenderer {
 
   // Light l's per-lane radiance in a path's result: the diagonal part, or (fl) the in side of the
   // rank-one term of a path that fluoresced.
-  const float* lane_values(const PathResult& r, int l, bool fl) const {
+  // `lanes`: the path's lane count, the rows' stride (the map's with fluorescence: no lane groups).
+  const float* lane_values(const PathResult& r, int l, bool fl, int lanes) const {
     const int src = m_c.source[l];
     if (src == -2) return fl ? r.fl_emission.data() : r.emission.data();
     if (src < 0) return fl ? r.fl_environment.data() : r.environment.data();
-    const auto row = static_cast<std::size_t>(src) * static_cast<std::size_t>(m_c.map.lanes());
+    const auto row = static_cast<std::size_t>(src) * static_cast<std::size_t>(lanes);
     return (fl ? r.fl_directional.data() : r.directional.data()) + row;
   }
 
@@ -184,10 +194,10 @@ class PixelRenderer {
         ok = add_single_segment(seg[r + PathResult::kSegmentLambda], a[0], bin,
                                 [&](int l) { return seg[r + segment_offset(l)]; }, v, vf) && ok;
       return add_single_segment(ps.cache.lambda_nm[0], a[0], bin,
-                                [&](int l) { return lane_values(ps.out, l, true)[0]; }, v, vf) && ok;
+                                [&](int l) { return lane_values(ps.out, l, true, m_c.map.lanes())[0]; }, v, vf) && ok;
     }
     for (int l = 0; l < nl; ++l) {
-      const float* src = lane_values(ps.out, l, true);
+      const float* src = lane_values(ps.out, l, true, m_c.map.lanes());
       double* out = v + static_cast<std::size_t>(l) * nb;
       // λin: the path's last wavelengths (a fluorescent event draws them anew; with two or more
       // events chained the folded light is taken at the last segment's, an approximation of the
@@ -340,6 +350,34 @@ WavelengthSampling resolve_wavelength_sampling(const Scene& scene) {
   return WavelengthSampling::SpectralTracking;
 }
 
+int resolve_mis_lane_groups(const Scene& scene) {
+  const spectral::BinLayout& bins = scene.settings.bins;
+  const int nb = bins.size();
+  if (nb < 2 || resolve_wavelength_sampling(scene) != WavelengthSampling::SpectralMis) return 1;
+  if (scene.settings.mis_lane_groups > 0) return std::min(scene.settings.mis_lane_groups, nb);
+  // The chromatic materials' bin-average extinction, then the fewest runs that keep each within the
+  // ratio. The measurements behind the rule: docs/renderer.md, "Lane groups".
+  std::vector<std::vector<double>> sigma;
+  for (const Material& m : scene.medium.materials) {
+    if (m.sigma_t_per_unit.is_constant()) continue;
+    std::vector<double>& v = sigma.emplace_back(static_cast<std::size_t>(nb));
+    for (int i = 0; i < nb; ++i) v[i] = m.sigma_t_per_unit.integrate(bins.lo_nm(i), bins.hi_nm(i)) / bins.width_nm(i);
+  }
+  const int most = std::max(1, nb / kMisGroupMinBins);
+  for (int g = 1; g < most; ++g) {
+    bool within = true;
+    for (int k = 0; k < g && within; ++k) {
+      const int b0 = WavelengthMap::run_begin(k, nb, g), b1 = WavelengthMap::run_begin(k + 1, nb, g);
+      for (const std::vector<double>& v : sigma) {
+        const auto [lo, hi] = std::minmax_element(v.begin() + b0, v.begin() + b1);
+        if (!(*hi <= kMisGroupExtinctionRatio * *lo)) within = false;
+      }
+    }
+    if (within) return g;
+  }
+  return most;
+}
+
 std::string sampler_name(Sampler s) { return s == Sampler::Sobol ? "sobol" : "independent"; }
 
 Sampler parse_sampler(std::string_view name, std::string_view input) {
@@ -377,7 +415,7 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
     mode = LaneMode::Single;
   else if (tracer.wavelength_independent())
     mode = LaneMode::Replicated;
-  const WavelengthMap map(mode, bins, sampling == WavelengthSampling::SpectralMis);
+  const WavelengthMap map(mode, bins, sampling == WavelengthSampling::SpectralMis, resolve_mis_lane_groups(scene));
   // Fluorescence (docs/fluorescence.md): the bispectral pairs the scene can fill; nothing of it
   // runs for a scene without fluorescence.
   const FluorescenceLayout fluor = fluorescence_layout(scene.medium, bins);

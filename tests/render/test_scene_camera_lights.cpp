@@ -38,6 +38,8 @@ TEST(SceneLoaderErrors, CameraAndSettings) {
       {"wavelength_sampling", "spectral-tracking", [](json& j) { j["wavelength_sampling"] = "hero"; }},
       {"sampler", "known: independent, sobol", [](json& j) { j["sampler"] = "halton"; }},
       {"event_probabilities", "\"max\", \"average\"", [](json& j) { j["event_probabilities"] = "maximum"; }},
+      {"mis_lane_groups", "must be \"auto\" or an integer ≥ 1 (got string \"four\")", [](json& j) { j["mis_lane_groups"] = "four"; }},
+      {"mis_lane_groups", "must be in [1, 1024] (got 0)", [](json& j) { j["mis_lane_groups"] = 0; }},
       {"output", "must not be empty", [](json& j) { j["output"] = ""; }},
   });
   json j = base_scene();

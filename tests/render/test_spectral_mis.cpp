@@ -38,10 +38,14 @@ using testing::make_material;
 using testing::pixel_average;
 using testing::same_bits;
 
-Scene with_mis(Scene s) {
+// Spectral MIS in `groups` lane groups (1: every bin on every path; the closed forms run with 1 and 3,
+// the six bins in three runs of two, each its own path per sample).
+Scene with_mis(Scene s, int groups = 1) {
   s.settings.wavelength_sampling = WavelengthSampling::SpectralMis;
+  s.settings.mis_lane_groups = groups;
   return s;
 }
+constexpr int kGroupings[] = {1, 3};
 
 using testing::bin_transmittance;
 
@@ -201,10 +205,12 @@ TEST(SpectralMis, BeerLambertPerBinWithExtinctionSpread100Times) {
   // null collisions; per column of voxels the depth D = Σ d/4, the window covering parts of 4×4
   // columns), and with one global cell.
   const double s400 = 0.05, s700 = 5.0;
+  for (const int groups : kGroupings)
   for (int variant = 0; variant < 3; ++variant) {
     Scene s = with_mis(box_scene(make_material(Spectrum::constant(0.0), Spectrum({400.0, 700.0}, {s400, s700}),
                                                Spectrum::constant(0.0)),
-                                 4, 8, 256));
+                                 4, 8, 256),
+                       groups);
     if (variant > 0) testing::randomise_density(s, 0.2f, 2.0f);
     s.settings.use_majorant_grid = variant != 2;
     const auto m = pixel_average(render(s), 0);
@@ -212,9 +218,9 @@ TEST(SpectralMis, BeerLambertPerBinWithExtinctionSpread100Times) {
       const double lo = s400 + (s700 - s400) * b / 6.0, hi = s400 + (s700 - s400) * (b + 1) / 6.0;
       const double expected =
           testing::column_window_average(s, [&](double depth) { return bin_transmittance(lo, hi, depth); });
-      EXPECT_NEAR(m.mean[b], expected, kSe * m.se[b]) << "variant " << variant << " bin " << b << ": " << m.mean[b]
-                                                      << " ± " << m.se[b] << ", expected " << expected;
-      EXPECT_LT(m.se[b], 0.08 * expected) << "variant " << variant << " bin " << b;
+      EXPECT_NEAR(m.mean[b], expected, kSe * m.se[b]) << groups << " groups, variant " << variant << " bin " << b << ": "
+                                                      << m.mean[b] << " ± " << m.se[b] << ", expected " << expected;
+      EXPECT_LT(m.se[b], 0.08 * expected) << groups << " groups, variant " << variant << " bin " << b;
     }
   }
 }
@@ -222,11 +228,12 @@ TEST(SpectralMis, BeerLambertPerBinWithExtinctionSpread100Times) {
 TEST(SpectralMis, ChromaticFurnaceIsOne) {
   // Albedo 1, σt from 6 to 1 per unit and g from 0.6 to 0.3 (then constant) over 400–700 nm, random
   // density: exactly 1 in every bin. The hero's phase lobe and free flights, every lane weighted.
+  for (const int groups : kGroupings)
   for (const auto& [g400, g700] : {std::pair{0.6, 0.3}, std::pair{0.4, 0.4}}) {
-    const auto m = pixel_average(render(with_mis(testing::chromatic_furnace(g400, g700, 8, 64))), 0);
+    const auto m = pixel_average(render(with_mis(testing::chromatic_furnace(g400, g700, 8, 64), groups)), 0);
     for (int i = 0; i < 6; ++i) {
-      EXPECT_NEAR(m.mean[i], 1.0, kSe * m.se[i] + 1e-6) << "g " << g400 << "–" << g700 << " bin " << i;
-      EXPECT_LT(m.se[i], 0.03) << "g " << g400 << "–" << g700 << " bin " << i;
+      EXPECT_NEAR(m.mean[i], 1.0, kSe * m.se[i] + 1e-6) << groups << " groups, g " << g400 << "–" << g700 << " bin " << i;
+      EXPECT_LT(m.se[i], 0.03) << groups << " groups, g " << g400 << "–" << g700 << " bin " << i;
     }
   }
 }
@@ -255,16 +262,18 @@ TEST(SpectralMis, HalfSpaceWithSpectralAlbedoAnisotropyAndExtinction) {
     const double gb = g[b];
     expected[b] = testing::HalfSpaceReflection(albedo[b], [gb](double c) { return hg(c, gb); }, mu0).radiance();
   }
+  for (const int groups : kGroupings)
   for (EventProbabilities e : {EventProbabilities::Auto, EventProbabilities::Max}) {
     Scene s = with_mis(testing::window_scene(make_material(table(albedo), Spectrum({400.0, 700.0}, {1500.0, 300.0}), table(g)),
-                                             testing::directional_light("sun", {std::sin(theta0), 0.0, mu0}), 16, 128));
+                                             testing::directional_light("sun", {std::sin(theta0), 0.0, mu0}), 16, 128),
+                       groups);
     s.settings.seed = 21;
     s.settings.event_probabilities = e;
     const auto m = pixel_average(render(s), 0);
     for (int b = 0; b < 6; ++b) {
-      EXPECT_NEAR(m.mean[b], expected[b], kSe * m.se[b])
-          << event_probabilities_name(e) << " bin " << b << ": " << m.mean[b] << " ± " << m.se[b] << " vs " << expected[b];
-      EXPECT_LT(m.se[b], 0.03 * expected[b]) << event_probabilities_name(e) << " bin " << b;
+      EXPECT_NEAR(m.mean[b], expected[b], kSe * m.se[b]) << groups << " groups, " << event_probabilities_name(e) << " bin "
+                                                         << b << ": " << m.mean[b] << " ± " << m.se[b] << " vs " << expected[b];
+      EXPECT_LT(m.se[b], 0.03 * expected[b]) << groups << " groups, " << event_probabilities_name(e) << " bin " << b;
     }
   }
 }
@@ -274,7 +283,8 @@ TEST(SpectralMis, AbsorbingEmittingSlabGivesLeTimesOneMinusTransmittance) {
   // 1: per bin 2·(1 − the bin average of e^{−σt}); the environment layer that average.
   Material mat = make_material(Spectrum::constant(0.0), Spectrum({400.0, 700.0}, {0.2, 4.0}), Spectrum::constant(0.0));
   mat.emission = Spectrum::constant(2.0);
-  Scene s = with_mis(box_scene(mat, 4, 8, 256));
+  for (const int groups : kGroupings) {
+  Scene s = with_mis(box_scene(mat, 4, 8, 256), groups);
   Light em;
   em.name = "emission";
   em.emission = true;
@@ -284,9 +294,10 @@ TEST(SpectralMis, AbsorbingEmittingSlabGivesLeTimesOneMinusTransmittance) {
   const auto env = pixel_average(img, 0), glow = pixel_average(img, 1);
   for (int b = 0; b < 6; ++b) {
     const double t = bin_transmittance(0.2 + 3.8 * b / 6.0, 0.2 + 3.8 * (b + 1) / 6.0, 1.0);
-    EXPECT_NEAR(glow.mean[b], 2.0 * (1.0 - t), kSe * glow.se[b]) << "bin " << b;
-    EXPECT_LT(glow.se[b], 0.02 * 2.0 * (1.0 - t)) << "bin " << b;
-    EXPECT_NEAR(env.mean[b], t, kSe * env.se[b]) << "bin " << b;
+    EXPECT_NEAR(glow.mean[b], 2.0 * (1.0 - t), kSe * glow.se[b]) << groups << " groups, bin " << b;
+    EXPECT_LT(glow.se[b], 0.02 * 2.0 * (1.0 - t)) << groups << " groups, bin " << b;
+    EXPECT_NEAR(env.mean[b], t, kSe * env.se[b]) << groups << " groups, bin " << b;
+  }
   }
 }
 
@@ -299,10 +310,14 @@ TEST(SpectralMis, TailsStayBoundedOverManySeeds) {
   // render's standard error stays near the median one, the spread of the renders' means is what
   // their standard errors say (a tail the renders miss shows as a spread above them; the reported
   // errors are conservative, the hero lanes being stratified), and each render's mean lies within
-  // 5 of its own standard errors of the seeds' mean. (tests/stress: the long form, 400 seeds.)
+  // 5 of its own standard errors of the seeds' mean. (tests/stress: the long form, 400 seeds.) With
+  // and without lane groups.
+  for (const int groups : kGroupings) {
+  SCOPED_TRACE(std::to_string(groups) + " lane groups");
   Scene s = with_mis(box_scene(make_material(Spectrum({400.0, 700.0}, {0.95, 0.4}), Spectrum({400.0, 700.0}, {8.0, 0.4}),
                                              Spectrum({400.0, 700.0}, {0.7, -0.2})),
-                               8, 8, 16));
+                               8, 8, 16),
+                     groups);
   testing::randomise_density(s, 0.0f, 2.0f);
   s.lights.push_back(testing::directional_light("sun", {0.4, 1.0, 0.3}));
   const int seeds = 40;
@@ -336,10 +351,13 @@ TEST(SpectralMis, TailsStayBoundedOverManySeeds) {
     for (int k = 0; k < seeds; ++k) EXPECT_NEAR(mean[k][i], m, 5.0 * se[k][i]) << "seed " << 100 + k << " value " << i;
   }
   EXPECT_LT(*std::max_element(peak.begin(), peak.end()), 2.0 * median(peak));
+  }
 }
 
 TEST(SpectralMis, ThreadCountAndShardsDoNotChangeABit) {
-  Scene s = with_mis(testing::chromatic_scene(16));
+  for (const int groups : kGroupings) {
+  SCOPED_TRACE(std::to_string(groups) + " lane groups");
+  Scene s = with_mis(testing::chromatic_scene(16), groups);
   s.settings.threads = 1;
   const auto one = render(s);
   s.settings.threads = 2;
@@ -366,6 +384,7 @@ TEST(SpectralMis, ThreadCountAndShardsDoNotChangeABit) {
   s.settings.sample_end = 16;
   s.settings.wavelength_sampling = WavelengthSampling::SpectralTracking;
   EXPECT_FALSE(same_bits(one, render(s)));
+  }
 }
 
 TEST(SpectralMis, GreyMediaRenderTheSameBitsWhateverTheSetting) {

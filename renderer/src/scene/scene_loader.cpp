@@ -43,7 +43,7 @@ void check_top_level(const Reader& rd, const json& root) {
     rd.fail("normalization", "give normalisation or normalization (the same field), not both");
   rd.expect_object(root, "",
                    {"description", "volume", "normalisation", "normalization", "materials", "transfer_function", "camera", "lights",
-                    "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "sampler", "event_probabilities", "target_error", "output",
+                    "bins", "samples", "seed", "max_bounces", "wavelength_sampling", "sampler", "event_probabilities", "mis_lane_groups", "target_error", "output",
                     "emission_light"});
   if (root.contains("description")) rd.string(root.at("description"), "description");
   if (!root.contains("volume")) rd.fail("volume", "is required");

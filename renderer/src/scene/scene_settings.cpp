@@ -1,5 +1,6 @@
 // The scene's bins and sampling (docs/scene-format.md, "Rendering"): the bin layout, samples, seed,
-// bounces, the wavelength sampling, the sampler, the event probabilities and the error target.
+// bounces, the wavelength sampling, the sampler, the event probabilities, spectral MIS's lane groups
+// and the error target.
 #include "prizma/spectral/spectral_exr.h"
 #include "scene_reader.h"
 
@@ -33,6 +34,16 @@ void read_settings(const Reader& rd, const json& root, RenderSettings& s) {
   if (root.contains("event_probabilities"))
     s.event_probabilities = parse_event_probabilities(rd.string(root.at("event_probabilities"), "event_probabilities"),
                                                       rd.input("event_probabilities"));
+  if (root.contains("mis_lane_groups")) {
+    const json& g = root.at("mis_lane_groups");
+    if (g.is_string()) {
+      if (g.get<std::string>() != "auto")
+        rd.fail("mis_lane_groups", "must be \"auto\" or an integer ≥ 1 (got " + Reader::describe(g) + ")");
+      s.mis_lane_groups = 0;
+    } else {
+      s.mis_lane_groups = static_cast<int>(rd.integer(g, "mis_lane_groups", 1, spectral::BinLayout::kMaxBins));
+    }
+  }
   if (root.contains("target_error")) {
     s.target_error = rd.number(root.at("target_error"), "target_error");
     if (s.target_error < 0.0) rd.fail("target_error", "must be ≥ 0 (got " + num(s.target_error) + ")");

@@ -35,7 +35,8 @@ struct RenderCallbacks {
 };
 
 struct RenderStats {
-  std::int64_t paths = 0;               // camera samples taken (including rays that miss the volume)
+  std::int64_t paths = 0;               // paths traced: camera samples (including rays that miss the
+                                        // volume) × spectral MIS's lane groups
   std::int64_t paths_in_volume = 0;     // samples whose camera ray hit the volume's bounds
   std::int64_t collisions = 0;          // real + null collisions of free-flight sampling
   std::int64_t shadow_steps = 0;        // ratio-tracking steps of next-event estimation
@@ -108,5 +109,15 @@ WavelengthSampling parse_wavelength_sampling(std::string_view name, std::string_
 // InputError("wavelength_sampling", …) for spectral-mis with a fluorescent material.
 inline constexpr double kMisExtinctionRatio = 1.1;
 WavelengthSampling resolve_wavelength_sampling(const Scene& scene);
+// Spectral MIS's lane groups for a render of `scene` (docs/renderer.md, "Lane groups"): 1 unless it
+// runs spectral MIS over several bins; RenderSettings::mis_lane_groups when ≥ 1 (clamped to the
+// bins); for auto (0) the fewest runs G of neighbouring bins (WavelengthMap::group_begin) in which
+// no material's bin-average extinction varies by more than kMisGroupExtinctionRatio, and never
+// runs of fewer than kMisGroupMinBins bins (G ≤ bins / kMisGroupMinBins). Not the default: groups
+// lower the transport's error per bin but make it less alike across the bins, so the colour error
+// under a broad light rises (the measurements in renderer.md).
+inline constexpr double kMisGroupExtinctionRatio = 3.5;
+inline constexpr int kMisGroupMinBins = 3;
+int resolve_mis_lane_groups(const Scene& scene);
 
 }  // namespace prizma::render
