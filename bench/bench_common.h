@@ -43,14 +43,17 @@ inline spectral::Spectrum grey_of(const spectral::Spectrum& s, double lo_nm, dou
 
 // The scene with every material's spectra replaced by their averages over the bins: the same geometry
 // and mean optical thickness, wavelength-independent (the renderer traces it once for all bins).
-inline render::Scene make_grey(render::Scene scene) {
-  const double lo = scene.settings.bins.min_nm(), hi = scene.settings.bins.max_nm();
+// With bin >= 0, the averages over that one bin instead: the medium lane `bin` sees, traced alone (what
+// a renderer that gave each bin its own paths would trace for it).
+inline render::Scene make_grey(render::Scene scene, int bin = -1) {
+  const spectral::BinLayout& b = scene.settings.bins;
+  const double lo = bin < 0 ? b.min_nm() : b.lo_nm(bin), hi = bin < 0 ? b.max_nm() : b.hi_nm(bin);
   for (auto& m : scene.medium.materials) {
     m.albedo = grey_of(m.albedo, lo, hi);
     m.sigma_t_per_unit = grey_of(m.sigma_t_per_unit, lo, hi);
     m.anisotropy = grey_of(m.anisotropy, lo, hi);
   }
-  scene.hash += "-grey";
+  scene.hash += bin < 0 ? "-grey" : "-grey-bin" + std::to_string(bin);
   return scene;
 }
 

@@ -25,6 +25,7 @@ struct Method {
   bool grid;
   pr::EventProbabilities events = pr::EventProbabilities::Auto;
   pr::Sampler sampler = pr::Sampler::Independent;
+  int mis_lane_groups = 1;  // spectral MIS's lane groups (1: none, the default; 0: the auto rule)
 };
 
 struct Options {
@@ -51,7 +52,8 @@ int main(int argc, char** argv) {
   app.add_option("--methods", o.methods,
                  "single, single-nogrid, spectral (auto event probabilities), spectral-nogrid, spectral-max, "
                  "spectral-average, spectral-mixed, spectral-implicit, spectral-sobol, single-sobol (the Sobol' sampler), "
-                 "spectral-tracking (= spectral), spectral-mis");
+                 "spectral-tracking (= spectral), spectral-mis, spectral-mis-G (spectral MIS in G lane groups; 0: the auto "
+                 "rule; spectral-mis = spectral-mis-1)");
   app.add_option("--size", o.size, "image width and height in pixels");
   app.add_option("--ref-spp", o.ref_spp, "reference samples per pixel (spectral tracking, grid)");
   app.add_option("--max-spp", o.max_spp, "largest sample count of the measured renders (powers of 2 up to it)");
@@ -79,6 +81,14 @@ int main(int argc, char** argv) {
   };
   std::vector<Method> methods;
   for (const std::string& name : o.methods) {
+    // "spectral-mis-G": spectral MIS in G lane groups (1: every bin on one path, as spectral-mis; 0: auto).
+    constexpr std::string_view kGroups = "spectral-mis-";
+    if (name.starts_with(kGroups) && name.size() > kGroups.size() &&
+        name.find_first_not_of("0123456789", kGroups.size()) == std::string::npos) {
+      methods.push_back({name, pr::WavelengthSampling::SpectralMis, true, pr::EventProbabilities::Auto,
+                         pr::Sampler::Independent, std::stoi(name.substr(kGroups.size()))});
+      continue;
+    }
     const auto it = std::find_if(known.begin(), known.end(), [&](const Method& m) { return m.name == name; });
     if (it == known.end()) {
       std::cerr << "bench_error_vs_time: error: --methods: unknown method \"" << name << "\"\n";
@@ -141,6 +151,7 @@ int main(int argc, char** argv) {
           s.settings.use_majorant_grid = m.grid;
           s.settings.event_probabilities = m.events;
           s.settings.sampler = m.sampler;
+          s.settings.mis_lane_groups = m.mis_lane_groups;
           s.settings.seed = o.seed;
           s.settings.write_variance = false;
           // Each sample count is a fresh render of samples [0, n): its wall time includes the set-up

@@ -11,7 +11,11 @@
 //   bench_spectral_mis [--scenes cube grey peer peer-grey ...] [--methods spectral-tracking spectral-mis]
 //                      [--spp 64] [--size 32] [--repeats 3] [--threads 2]
 // Prints per scene and method the median efficiency, MIS ÷ tracking, chromatic ÷ grey cost pairs
-// (X with X-grey, cube with grey) and the load at the start and the end.
+// (X with X-grey, cube with grey) and the load at the start and the end. With --per-bin K it also
+// renders every K-th bin's medium alone (the scene's materials averaged over that bin, traced as a
+// grey medium) and splits each chromatic ÷ grey cost into the estimator's factor (chromatic ÷ the
+// lanes traced alone: what sharing one path among the lanes costs) and the scene's own (the lanes
+// traced alone ÷ the grey version: what the grey estimator itself pays at each bin's coefficients).
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -41,21 +45,39 @@ double cpu_seconds() {
          1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-// Σ var / Σ mean² over the volume pixels' values (the pixel means' variance, relative).
-double relative_variance(const ps::SpectralImage& img) {
+struct VarianceSums {
+  double var = 0.0, sq = 0.0;  // Σ var and Σ mean² over the volume pixels' values
+  double relative() const { return sq > 0.0 ? var / sq : 0.0; }
+};
+
+// The sums over every light and bin of the volume pixels (background pixels, exactly 0 or 1
+// everywhere, left out), or over bin `only_bin` alone.
+VarianceSums variance_sums(const ps::SpectralImage& img, int only_bin = -1) {
   const std::vector<char> background = pb::background_mask(img);
   const std::size_t nb = static_cast<std::size_t>(img.bins.size());
-  double var = 0.0, sq = 0.0;
+  VarianceSums out;
   for (const auto& layer : img.lights)
     for (std::size_t p = 0; p < img.pixel_count(); ++p) {
       if (background[p]) continue;
       for (std::size_t i = 0; i < nb; ++i) {
-        var += layer.variance[p * nb + i];
-        sq += static_cast<double>(layer.data[p * nb + i]) * layer.data[p * nb + i];
+        if (only_bin >= 0 && i != static_cast<std::size_t>(only_bin)) continue;
+        out.var += layer.variance[p * nb + i];
+        out.sq += static_cast<double>(layer.data[p * nb + i]) * layer.data[p * nb + i];
       }
     }
-  return sq > 0.0 ? var / sq : 0.0;
+  return out;
 }
+
+// Σ var / Σ mean² over the volume pixels' values (the pixel means' variance, relative).
+double relative_variance(const ps::SpectralImage& img) { return variance_sums(img).relative(); }
+
+// Real and null collisions per path that entered the volume.
+double collisions_per_path(const pr::RenderStats& st) {
+  return st.paths_in_volume > 0 ? static_cast<double>(st.collisions) / static_cast<double>(st.paths_in_volume) : 0.0;
+}
+
+// The chromatic scene's grey partner in the bench's naming (cube → grey, X → X-grey).
+std::string grey_partner(const std::string& name) { return name == "cube" ? "grey" : name + "-grey"; }
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -69,17 +91,36 @@ int main(int argc, char** argv) {
   std::vector<std::string> scenes{"grey", "cube", "peer", "peer-grey", "metamers", "mri", "sky_haze", "cloud_vdb"};
   std::vector<std::string> methods{"spectral-tracking", "spectral-mis"};
   std::int64_t spp = 64;
-  int size = 32, repeats = 3, threads = 2;
+  int size = 32, repeats = 3, threads = 2, per_bin = 0;
+  std::vector<int> groups;
   CLI::App app{"Spectral MIS against spectral tracking, and chromatic against grey, by efficiency"};
   app.add_option("--scenes", scenes, "bench scenes: grey, cube, peer, a data/scenes/NAME, NAME-grey");
-  app.add_option("--methods", methods, "spectral-tracking, spectral-mis, auto, single");
+  app.add_option("--methods", methods,
+                 "spectral-tracking, spectral-mis, spectral-mis:G (spectral MIS in G lane groups; 1: none, as "
+                 "spectral-mis; 0: the auto rule), auto, single");
   app.add_option("--spp", spp, "samples per pixel of each render");
   app.add_option("--size", size, "image width and height in pixels");
   app.add_option("--repeats", repeats, "renders per scene and method (seeds 1, 2, …; the median is kept)");
   app.add_option("--threads", threads, "render threads");
+  app.add_option("--per-bin", per_bin,
+                 "also render, for each chromatic scene with its grey version in --scenes, every K-th bin's "
+                 "grey medium alone (0: none) and split chromatic ÷ grey into the estimator's factor and the "
+                 "scene's own")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--groups", groups,
+                 "also render, for each chromatic scene with its grey version in --scenes, its bins split into G "
+                 "runs of neighbouring bins, each run under spectral MIS by itself (one path per run and camera "
+                 "sample), for each G given")
+      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
 
-  std::map<std::string, std::map<std::string, std::vector<double>>> eff, relvar, cpu;
+  std::map<std::string, std::map<std::string, std::vector<double>>> eff, relvar, cpu, coll;
+  // --per-bin: per chromatic scene, per repeat, the lanes traced alone: the relative variance over
+  // the rendered bins (Σ var / Σ mean²) and the mean CPU seconds of one bin's render.
+  std::map<std::string, std::vector<double>> alone_relvar, alone_cpu, alone_coll;
+  std::map<std::string, int> alone_bins;
+  // --groups: per chromatic scene and G, per repeat, the same for the G runs of bins together.
+  std::map<std::string, std::map<int, std::vector<double>>> group_relvar, group_cpu;
   std::map<std::string, pr::Scene> loaded;
   try {
     for (const std::string& name : scenes) {
@@ -99,11 +140,14 @@ int main(int argc, char** argv) {
     }
     std::cout << "bench_spectral_mis: " << size << "×" << size << ", " << spp << " spp, " << threads
               << " threads, " << repeats << " repeats; load at start " << pb::load_average() << "\n";
-    for (int r = 0; r < repeats; ++r)
+    for (int r = 0; r < repeats; ++r) {
       for (auto& [name, scene] : loaded)
         for (const std::string& m : methods) {
           pr::Scene s = scene;
-          s.settings.wavelength_sampling = pr::parse_wavelength_sampling(m, "--methods");
+          // "spectral-mis:G": spectral MIS in G lane groups (1: every bin on one path; 0: the auto rule).
+          const std::size_t colon = m.find(':');
+          s.settings.wavelength_sampling = pr::parse_wavelength_sampling(m.substr(0, colon), "--methods");
+          if (colon != std::string::npos) s.settings.mis_lane_groups = std::stoi(m.substr(colon + 1));
           s.settings.seed = static_cast<std::uint64_t>(r + 1);
           try {
             (void)pr::resolve_wavelength_sampling(s);
@@ -112,12 +156,66 @@ int main(int argc, char** argv) {
             continue;
           }
           const double c0 = cpu_seconds();
-          const ps::SpectralImage img = pr::render(s);
+          pr::RenderStats st;
+          const ps::SpectralImage img = pr::render(s, {}, &st);
           const double c = cpu_seconds() - c0, v = relative_variance(img);
           cpu[name][m].push_back(c);
+          coll[name][m].push_back(collisions_per_path(st));
           relvar[name][m].push_back(v);
           eff[name][m].push_back(v > 0.0 && c > 0.0 ? 1.0 / (v * c) : 0.0);
         }
+      // Each lane's medium traced alone (the scene's materials averaged over one bin): what the grey
+      // estimator pays at that bin's coefficients, in the same interleaving as the renders above.
+      for (auto& [name, scene] : loaded) {
+        if (per_bin == 0 || !loaded.count(grey_partner(name))) continue;
+        VarianceSums sums;
+        double c_sum = 0.0, coll_sum = 0.0;
+        int& bins = alone_bins[name];
+        bins = 0;
+        for (int b = 0; b < scene.settings.bins.size(); b += per_bin, ++bins) {
+          pr::Scene s = pb::make_grey(scene, b);
+          s.settings.seed = static_cast<std::uint64_t>(r + 1);
+          const double c0 = cpu_seconds();
+          pr::RenderStats st;
+          const ps::SpectralImage img = pr::render(s, {}, &st);
+          c_sum += cpu_seconds() - c0;
+          coll_sum += collisions_per_path(st);
+          const VarianceSums v = variance_sums(img, b);
+          sums.var += v.var;
+          sums.sq += v.sq;
+        }
+        alone_relvar[name].push_back(sums.relative());
+        alone_cpu[name].push_back(c_sum / bins);
+        alone_coll[name].push_back(coll_sum / bins);
+      }
+      // The bins in G runs, each its own spectral-MIS render: one path per run and camera sample.
+      for (auto& [name, scene] : loaded) {
+        if (!loaded.count(grey_partner(name))) continue;
+        const std::vector<double>& edges = scene.settings.bins.edges_nm();
+        const int n = scene.settings.bins.size();
+        for (const int g : groups) {
+          if (g > n) continue;
+          VarianceSums sums;
+          double c_sum = 0.0;
+          for (int k = 0; k < g; ++k) {
+            pr::Scene s = scene;
+            const int lo = k * n / g, hi = (k + 1) * n / g;
+            s.settings.bins = ps::BinLayout::from_edges({edges.begin() + lo, edges.begin() + hi + 1});
+            s.settings.wavelength_sampling = pr::WavelengthSampling::SpectralMis;
+            s.settings.mis_lane_groups = 1;
+            s.settings.seed = static_cast<std::uint64_t>(r + 1);
+            const double c0 = cpu_seconds();
+            const ps::SpectralImage img = pr::render(s);
+            c_sum += cpu_seconds() - c0;
+            const VarianceSums v = variance_sums(img);
+            sums.var += v.var;
+            sums.sq += v.sq;
+          }
+          group_relvar[name][g].push_back(sums.relative());
+          group_cpu[name][g].push_back(c_sum);
+        }
+      }
+    }
   } catch (const ps::InputError& e) {
     std::cerr << "bench_spectral_mis: error: " << e.what() << "\n";
     return 2;
@@ -130,20 +228,48 @@ int main(int argc, char** argv) {
     std::cout << name << ":\n";
     for (const auto& [m, e] : per)
       std::cout << "  " << std::setw(18) << std::left << m << std::right << " rel. variance " << median(relvar[name][m])
-                << "  CPU " << median(cpu[name][m]) << " s  efficiency " << median(e) << "\n";
+                << "  CPU " << median(cpu[name][m]) << " s  efficiency " << median(e) << "  collisions per path "
+                << median(coll[name][m]) << "\n";
     if (per.count("spectral-tracking") && per.count("spectral-mis"))
       std::cout << "  spectral-mis ÷ spectral-tracking efficiency: "
                 << median(per.at("spectral-mis")) / median(per.at("spectral-tracking")) << "×\n";
   }
   // Chromatic ÷ grey cost at equal error: the grey version's efficiency over the chromatic one's.
   for (const auto& [name, per] : eff) {
-    const std::string grey = name == "cube" ? "grey" : name + "-grey";
+    const std::string grey = grey_partner(name);
     if (!eff.count(grey)) continue;
     // A grey medium is one lane whatever the method: its first method's renders stand for all.
     const auto& [gm, ge] = *eff.at(grey).begin();
     for (const auto& [m, e] : per)
       std::cout << name << " (" << m << ") ÷ " << grey << " (" << gm << ") cost at equal error: "
                 << median(ge) / median(e) << "×\n";
+    if (!alone_relvar.count(name)) continue;
+    // cost ratio = (CPU ratio)·(variance ratio), split at the lanes traced alone: the estimator's
+    // factor (sharing one path among the lanes, and their arithmetic) times the scene's own (what
+    // the grey estimator itself pays at each bin's coefficients against the bin average's).
+    const double va = median(alone_relvar.at(name)), ca = median(alone_cpu.at(name));
+    const double vg = median(relvar.at(grey).at(gm)), cg = median(cpu.at(grey).at(gm));
+    std::cout << "  " << name << "'s lanes traced alone (" << alone_bins.at(name)
+              << " bins, each its grey medium): rel. variance " << va << ", CPU " << ca << " s per bin, collisions per path "
+              << median(alone_coll.at(name)) << "\n";
+    std::cout << "  scene factor (alone ÷ " << grey << "): CPU " << ca / cg << "× · variance " << va / vg << "× = "
+              << ca * va / (cg * vg) << "×\n";
+    for (const auto& [m, e] : per) {
+      const double vm = median(relvar.at(name).at(m)), cm = median(cpu.at(name).at(m));
+      std::cout << "  estimator factor (" << m << " ÷ alone): CPU " << cm / ca << "× · variance " << vm / va
+                << "× = " << cm * vm / (ca * va) << "×\n";
+    }
+  }
+  // --groups: the G runs' summed CPU and pooled variance, against the grey version's one path.
+  for (const auto& [name, per_g] : group_relvar) {
+    const std::string grey = grey_partner(name);
+    const auto& [gm, ge] = *eff.at(grey).begin();
+    const double vg = median(relvar.at(grey).at(gm)), cg = median(cpu.at(grey).at(gm));
+    for (const auto& [g, v] : per_g) {
+      const double vr = median(v), cr = median(group_cpu.at(name).at(g));
+      std::cout << name << " in " << g << " runs of bins (spectral-mis each) ÷ " << grey << ": CPU " << cr / cg
+                << "× · variance " << vr / vg << "× = " << cr * vr / (cg * vg) << "× cost at equal error\n";
+    }
   }
   std::cout << "load at end " << pb::load_average() << "\n";
   return 0;
