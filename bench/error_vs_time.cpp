@@ -25,7 +25,7 @@ struct Method {
   bool grid;
   pr::EventProbabilities events = pr::EventProbabilities::Auto;
   pr::Sampler sampler = pr::Sampler::Independent;
-  int mis_lane_groups = 1;  // spectral MIS's lane groups (1: none, the default; 0: the auto rule)
+  int mis_lane_groups = 0;  // spectral MIS's lane groups (0: the auto rule, the default; 1: none)
 };
 
 struct Options {
@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
                  "single, single-nogrid, spectral (auto event probabilities), spectral-nogrid, spectral-max, "
                  "spectral-average, spectral-mixed, spectral-implicit, spectral-sobol, single-sobol (the Sobol' sampler), "
                  "spectral-tracking (= spectral), spectral-mis, spectral-mis-G (spectral MIS in G lane groups; 0: the auto "
-                 "rule; spectral-mis = spectral-mis-1)");
+                 "rule, = spectral-mis; 1: none)");
   app.add_option("--size", o.size, "image width and height in pixels");
   app.add_option("--ref-spp", o.ref_spp, "reference samples per pixel (spectral tracking, grid)");
   app.add_option("--max-spp", o.max_spp, "largest sample count of the measured renders (powers of 2 up to it)");

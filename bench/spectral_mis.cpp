@@ -96,8 +96,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Spectral MIS against spectral tracking, and chromatic against grey, by efficiency"};
   app.add_option("--scenes", scenes, "bench scenes: grey, cube, peer, a data/scenes/NAME, NAME-grey");
   app.add_option("--methods", methods,
-                 "spectral-tracking, spectral-mis, spectral-mis:G (spectral MIS in G lane groups; 1: none, as "
-                 "spectral-mis; 0: the auto rule), auto, single");
+                 "spectral-tracking, spectral-mis (lane groups by the auto rule), spectral-mis:G (G lane groups; "
+                 "1: none), auto, single");
   app.add_option("--spp", spp, "samples per pixel of each render");
   app.add_option("--size", size, "image width and height in pixels");
   app.add_option("--repeats", repeats, "renders per scene and method (seeds 1, 2, …; the median is kept)");

@@ -107,15 +107,18 @@ class PixelRenderer {
       const double py = y + rng.uniform_double();
       const Ray ray = m_c.camera.generate(px, py);
       const SampleIndex at{.seed = st.seed, .pixel = pix, .sample = s};
-      // One path per lane group (one path without groups), all from the same camera ray.
+      // One path per lane group (one path without groups), all from the same camera ray and the same
+      // random numbers (common random numbers: the groups' paths coincide as far as their lanes'
+      // media agree, so their errors stay alike across the bins, as one path's are).
       bool finite = true;
       double guides[2];
       const int groups = m_c.map.groups();
       for (int k = 0; k < groups; ++k) {
-        const WavelengthDraw draw = m_c.map.draw(rng, ps.in.lambda_nm.data(), at, k);
+        Rng path_rng = rng;
+        const WavelengthDraw draw = m_c.map.draw(path_rng, ps.in.lambda_nm.data(), at, k);
         if (draw.hero >= 0) ps.in.hero_lane = draw.hero;
         ps.lanes = draw.lanes;  // a lane group's: fewer than prepared
-        m_c.tracer.trace(ray, rng, ps);
+        m_c.tracer.trace(ray, path_rng, ps);
         ++ts.paths;
 
         // Lanes → (light, bin) values of this sample (with lane groups: the group's bins).
@@ -133,9 +136,8 @@ class PixelRenderer {
           for (int i = b0; i < b1; ++i) finite = finite && std::isfinite(out[i]);
         }
         if (m_c.fluorescent) finite = add_fluorescent_sample(ps, draw.bin, v, ts.value_fl.data()) && finite;
-        // The guides from the first path: it starts at the sample's first random numbers, so what it
-        // sees before its first event does not depend on the lights (the later groups' paths start
-        // after the earlier ones' light estimates).
+        // The guides from the first group's path (the others' first scattering differs only by their
+        // lanes' extinction).
         if (k == 0) guide_sample(ps.out, guides);
       }
       if (!finite) {

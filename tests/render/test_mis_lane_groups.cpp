@@ -89,24 +89,24 @@ Scene rayleigh_box(int n) {
   return s;
 }
 
-// rayleigh_box with the lane groups' auto rule asked for.
+// rayleigh_box with the lane groups' auto rule (the default).
 int auto_groups(Scene s) {
   s.settings.mis_lane_groups = 0;
   return resolve_mis_lane_groups(s);
 }
 
-TEST(MisLaneGroups, AutoRuleKeepsEachRunsExtinctionWithinThreeAndAHalfAndRunsOfThreeBins) {
-  EXPECT_EQ(resolve_mis_lane_groups(rayleigh_box(32)), 1);  // the default: no groups
-  // 32 bins of Rayleigh air (9.4× over 400–700 nm): two runs of 16 bins hold the bin averages
-  // within (545.3/404.7)⁴ = 3.30×, one run not (8.7×): 2 groups (bench_peer).
-  EXPECT_EQ(auto_groups(rayleigh_box(32)), 2);
-  // 12 bins (the cube's layout): runs of 6 within (537.5/412.5)⁴ = 2.88×: 2.
-  EXPECT_EQ(auto_groups(rayleigh_box(12)), 2);
-  // 30 bins over 380–780 nm (λ⁻⁴: 17.7×): two runs of 15 reach (573.3/386.7)⁴ = 4.83×, three of 10
-  // (513.3/386.7)⁴ = 3.10×: 3.
+TEST(MisLaneGroups, AutoRuleKeepsEachRunsExtinctionWithinTwoAndAHalfAndRunsOfThreeBins) {
+  EXPECT_EQ(resolve_mis_lane_groups(rayleigh_box(32)), auto_groups(rayleigh_box(32)));  // auto is the default
+  // 32 bins of Rayleigh air (9.4× over 400–700 nm): three runs of 10–11 bins hold the bin averages
+  // within (489.1/404.7)⁴ = 2.13×, two runs of 16 not ((545.3/404.7)⁴ = 3.30×): 3 groups (bench_peer).
+  EXPECT_EQ(auto_groups(rayleigh_box(32)), 3);
+  // 12 bins (the cube's layout): runs of 4 within (487.5/412.5)⁴ = 1.95×, of 6 not (2.89×): 3.
+  EXPECT_EQ(auto_groups(rayleigh_box(12)), 3);
+  // 30 bins over 380–780 nm (λ⁻⁴: 17.7×): three runs of 10 reach (506.7/386.7)⁴ = 2.95×, four of
+  // 7–8 bins (466.7/386.7)⁴ = 2.12× at most: 4.
   Scene wide = rayleigh_box(30);
   wide.settings.bins = spectral::BinLayout::linear(380, 780, 30);
-  EXPECT_EQ(auto_groups(wide), 3);
+  EXPECT_EQ(auto_groups(wide), 4);
   // The rule's floor: never runs of fewer than 3 bins (4 bins: one group).
   EXPECT_EQ(auto_groups(rayleigh_box(4)), 1);
   // An extinction that drops to 0 in some bins cannot be held within any ratio by a run across

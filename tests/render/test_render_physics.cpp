@@ -32,7 +32,9 @@ TEST(RenderPhysics, BeerLambertPerBin) {
   const auto img = render(s, {}, &stats);
   ASSERT_EQ(img.lights.size(), 2u);
   EXPECT_EQ(stats.nan_or_inf_count, 0);
-  EXPECT_EQ(stats.paths, 8 * 8 * 256);  // spectral MIS (auto), one path per sample (no lane groups)
+  // σt 6× across the 6 bins: spectral MIS (auto) in 2 lane groups (auto), a path per group and sample.
+  ASSERT_EQ(resolve_mis_lane_groups(s), 2);
+  EXPECT_EQ(stats.paths, 8 * 8 * 256 * 2);
   const auto e = pixel_average(img, 0);
   for (int i = 0; i < 6; ++i) {
     const double a = 0.5 + 2.5 * (i / 6.0), b = 0.5 + 2.5 * ((i + 1) / 6.0);

@@ -72,8 +72,8 @@ TEST(SceneLoader, DefaultsWhenOptionalFieldsAreMissing) {
   EXPECT_EQ(load_scene(dir / "minimal.json", {parse_scene_override("event_probabilities=implicit")})
                 .settings.event_probabilities,
             EventProbabilities::Implicit);
-  // Spectral MIS's lane groups: one (every bin on one path) unless the scene or -D says otherwise.
-  EXPECT_EQ(s.settings.mis_lane_groups, 1);
+  // Spectral MIS's lane groups: auto (0) unless the scene or -D gives a count.
+  EXPECT_EQ(s.settings.mis_lane_groups, 0);
   EXPECT_EQ(load_scene(dir / "minimal.json", {parse_scene_override("mis_lane_groups=3")}).settings.mis_lane_groups, 3);
   EXPECT_EQ(load_scene(dir / "minimal.json", {parse_scene_override("mis_lane_groups=auto")}).settings.mis_lane_groups, 0);
 }

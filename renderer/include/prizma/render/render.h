@@ -113,10 +113,9 @@ WavelengthSampling resolve_wavelength_sampling(const Scene& scene);
 // runs spectral MIS over several bins; RenderSettings::mis_lane_groups when ≥ 1 (clamped to the
 // bins); for auto (0) the fewest runs G of neighbouring bins (WavelengthMap::group_begin) in which
 // no material's bin-average extinction varies by more than kMisGroupExtinctionRatio, and never
-// runs of fewer than kMisGroupMinBins bins (G ≤ bins / kMisGroupMinBins). Not the default: groups
-// lower the transport's error per bin but make it less alike across the bins, so the colour error
-// under a broad light rises (the measurements in renderer.md).
-inline constexpr double kMisGroupExtinctionRatio = 3.5;
+// runs of fewer than kMisGroupMinBins bins (G ≤ bins / kMisGroupMinBins). The ratio and the
+// measurements behind it: renderer.md.
+inline constexpr double kMisGroupExtinctionRatio = 2.5;
 inline constexpr int kMisGroupMinBins = 3;
 int resolve_mis_lane_groups(const Scene& scene);
 

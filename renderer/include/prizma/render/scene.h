@@ -140,9 +140,9 @@ struct RenderSettings {
   // Spectral tracking's collision event probabilities (event_probability.h); Auto: chosen from the
   // materials' spectra when the tracer is built.
   EventProbabilities event_probabilities = EventProbabilities::Auto;
-  // Spectral MIS's lane groups (resolve_mis_lane_groups, render.h): 1 (the default) = every bin on
-  // one path, G = the bins in G runs of neighbouring bins, one path per run and sample; 0 = auto.
-  int mis_lane_groups = 1;
+  // Spectral MIS's lane groups (resolve_mis_lane_groups, render.h): 0 = auto (the default), 1 = every
+  // bin on one path, G = the bins in G runs of neighbouring bins, one path per run and sample.
+  int mis_lane_groups = 0;
   double target_error = 0.0;          // > 0: stop a pixel once its relative standard error ≤ this
   bool use_majorant_grid = true;
   int threads = 0;                    // 0 = all cores
