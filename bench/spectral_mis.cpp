@@ -30,6 +30,7 @@
 #include "bench_common.h"
 #include "bench_image.h"
 #include "prizma/render/render.h"
+#include "prizma/render/wavelength_map.h"
 #include "prizma/spectral/error.h"
 
 namespace pb = prizma::bench;
@@ -199,7 +200,7 @@ int main(int argc, char** argv) {
           double c_sum = 0.0;
           for (int k = 0; k < g; ++k) {
             pr::Scene s = scene;
-            const int lo = k * n / g, hi = (k + 1) * n / g;
+            const int lo = pr::WavelengthMap::run_begin(k, n, g), hi = pr::WavelengthMap::run_begin(k + 1, n, g);
             s.settings.bins = ps::BinLayout::from_edges({edges.begin() + lo, edges.begin() + hi + 1});
             s.settings.wavelength_sampling = pr::WavelengthSampling::SpectralMis;
             s.settings.mis_lane_groups = 1;

@@ -360,11 +360,8 @@ int resolve_mis_lane_groups(const Scene& scene) {
   // The chromatic materials' bin-average extinction, then the fewest runs that keep each within the
   // ratio. The measurements behind the rule: docs/renderer.md, "Lane groups".
   std::vector<std::vector<double>> sigma;
-  for (const Material& m : scene.medium.materials) {
-    if (m.sigma_t_per_unit.is_constant()) continue;
-    std::vector<double>& v = sigma.emplace_back(static_cast<std::size_t>(nb));
-    for (int i = 0; i < nb; ++i) v[i] = m.sigma_t_per_unit.integrate(bins.lo_nm(i), bins.hi_nm(i)) / bins.width_nm(i);
-  }
+  for (const Material& m : scene.medium.materials)
+    if (!m.sigma_t_per_unit.is_constant()) sigma.push_back(m.sigma_t_per_unit.bin_averages(bins));
   const int most = std::max(1, nb / kMisGroupMinBins);
   for (int g = 1; g < most; ++g) {
     bool within = true;
