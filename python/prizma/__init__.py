@@ -55,7 +55,8 @@ class Image:
             for the lights that have one.
         bin_edges_nm: float64 array of the bins + 1 exact bin edges in nm.
         attributes: dict of the file's prizma: attributes: samples, sample_range, seed, scene_hash,
-            version, wavelength_sampling, scene_path, render_options, lights (the recorded lights,
+            version, wavelength_sampling, mis_lane_groups (spectral MIS's paths per sample, 0 when not
+            recorded), scene_path, render_options, lights (the recorded lights,
             a list of dicts: name, direction, angularSizeDeg, spectrum), denoised (None for raw
             Monte Carlo means, else prizma:denoised as a dict: method, version, guides, variance,
             parameters; :func:`denoise`) and is_prizma.

@@ -112,6 +112,7 @@ py::dict image_to_py(spectral::SpectralImage&& image) {
   a["scene_hash"] = info.scene_hash;
   a["version"] = info.version;
   a["wavelength_sampling"] = info.wavelength_sampling;
+  a["mis_lane_groups"] = info.mis_lane_groups;
   a["scene_path"] = info.scene_path;
   a["render_options"] = info.render_options;
   a["denoised"] = info.denoised;
@@ -139,8 +140,8 @@ using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecas
 // ---------------------------------------------------------------------------------------------
 // SpectralImage ↔ Python. The Python side is a plain dict (prizma.Image wraps it):
 //   width, height, bin_edges_nm (float64 n+1), lights {name: float32 H×W×n}, variance {name: …},
-//   attributes {samples, sample_range, seed, scene_hash, version, wavelength_sampling, scene_path,
-//               render_options, denoised, lights_json, is_prizma}
+//   attributes {samples, sample_range, seed, scene_hash, version, wavelength_sampling, mis_lane_groups,
+//               scene_path, render_options, denoised, lights_json, is_prizma}
 
 template <typename T>
 T attribute_or(const py::dict& attrs, const char* key, T fallback) {
@@ -263,6 +264,7 @@ spectral::SpectralImage image_from_py(const py::dict& d) {
   info.scene_hash = attribute_or<std::string>(attrs, "scene_hash", "");
   info.version = attribute_or<std::string>(attrs, "version", "");
   info.wavelength_sampling = attribute_or<std::string>(attrs, "wavelength_sampling", "");
+  info.mis_lane_groups = attribute_or<int>(attrs, "mis_lane_groups", 0);
   info.scene_path = attribute_or<std::string>(attrs, "scene_path", "");
   info.render_options = attribute_or<std::string>(attrs, "render_options", "");
   info.denoised = attribute_or<std::string>(attrs, "denoised", "");

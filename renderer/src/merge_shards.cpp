@@ -139,6 +139,7 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
     if (s.info.scene_hash != first.info.scene_hash) refuse("scene hash");
     if (s.info.seed != first.info.seed) refuse("seed");
     if (s.info.wavelength_sampling != first.info.wavelength_sampling) refuse("wavelength sampling");
+    if (s.info.mis_lane_groups != first.info.mis_lane_groups) refuse("spectral MIS's lane groups (prizma:misLaneGroups)");
     if (s.info.light_records != first.info.light_records || s.lights.size() != first.lights.size()) refuse("lights");
     for (std::size_t l = 0; l < s.lights.size(); ++l)
       if (s.lights[l].name != first.lights[l].name) refuse("lights");

@@ -491,6 +491,7 @@ spectral::SpectralImage render_scene(const Scene& scene, const RenderCallbacks& 
   img.info.scene_hash = scene.hash;
   img.info.version = spectral::prizma_version();
   img.info.wavelength_sampling = wavelength_sampling_name(sampling);
+  if (sampling == WavelengthSampling::SpectralMis) img.info.mis_lane_groups = map.groups();
 
   if (stats_out) {
     RenderStats s;

@@ -42,8 +42,10 @@ def test_write_read_round_trip(tiny_exr, tmp_path):
         np.testing.assert_array_equal(back.lights[name], image.lights[name])
         np.testing.assert_array_equal(back.variance[name], image.variance[name])
     np.testing.assert_array_equal(back.bin_edges_nm, image.bin_edges_nm)
-    for key in ("samples", "sample_range", "seed", "scene_hash", "wavelength_sampling", "lights"):
+    for key in ("samples", "sample_range", "seed", "scene_hash", "wavelength_sampling", "mis_lane_groups", "lights"):
         assert back.attributes[key] == image.attributes[key], key
+    # tiny.json's chromatic haze: spectral MIS in 2 lane groups under auto, recorded in the file
+    assert (image.attributes["wavelength_sampling"], image.attributes["mis_lane_groups"]) == ("spectral-mis", 2)
     assert prizma.checksum(back) == prizma.checksum(image)
 
 

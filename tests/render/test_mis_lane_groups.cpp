@@ -10,8 +10,13 @@
 #include <vector>
 
 #include "prizma/render/render.h"
+#include "prizma/render/resume.h"
+#include "prizma/render/scene.h"
 #include "prizma/render/wavelength_map.h"
+#include "prizma/spectral/error.h"
+#include "prizma/spectral/spectral_exr.h"
 #include "render_test_scenes.h"
+#include "test_scene_util.h"
 
 namespace prizma::render {
 namespace {
@@ -155,6 +160,60 @@ TEST(MisLaneGroups, ARenderTracesOnePathPerGroupAndEveryBinGetsItsShare) {
         }
       }
   EXPECT_FALSE(testing::same_bits(grouped, one));
+}
+
+// A file records the groups its samples were traced with (prizma:misLaneGroups), and --resume and
+// merge keep to them whatever `auto` resolves to in this build: a file of spectral MIS without the
+// attribute (written before lane groups) continues with one path for all bins, the samples a
+// one-group render takes, bit for bit; shards of different groups are refused.
+TEST(MisLaneGroups, FilesRecordTheirGroupsAndResumeAndMergeKeepThem) {
+  const testing::ScratchDir dir;
+  // tests/e2e/render/tiny.json's medium: Gaussian extinction over 6 bins, 2 groups under auto.
+  const auto scene_path = dir.write("tiny.json", R"({
+    "volume": {"type": "procedural", "name": "cube_sphere", "resolution": 16},
+    "materials": [
+      {"name": "haze", "range": [50, 150], "albedo": 0.9, "extinction": {"spectrum": "gaussian:450:200", "scale": 3}},
+      {"name": "core", "range": [200, 255], "albedo": 0.5, "extinction": 10}
+    ],
+    "camera": {"type": "orthographic", "position": [0, 0, 2], "look_at": [0, 0, 0], "up": [0, 1, 0],
+               "ortho_height": 1.2, "width": 6, "height": 6},
+    "lights": [{"name": "side", "direction": [1, 0, 0]}, {"name": "sky", "direction": [0, 0, 0]}],
+    "bins": "linear:400:700:6", "samples": 4, "seed": 3, "output": "tiny.exr"
+  })");
+  Scene scene = load_scene(scene_path);
+  ASSERT_EQ(resolve_wavelength_sampling(scene), WavelengthSampling::SpectralMis);
+  ASSERT_EQ(resolve_mis_lane_groups(scene), 2);
+  scene.settings.sample_end = 2;
+  spectral::SpectralImage part = render(scene);
+  EXPECT_EQ(part.info.mis_lane_groups, 2);
+  auto resumed_groups = [&](int recorded, const char* name) {
+    part.info.mis_lane_groups = recorded;
+    const auto file = dir.path() / name;
+    spectral::write_spectral_exr(file, part);
+    EXPECT_EQ(spectral::read_spectral_exr(file).info.mis_lane_groups, recorded);
+    const ResumePlan plan = plan_resume(ResumeRequest{file, scene_path, {}, 4, true});
+    EXPECT_EQ(plan.scene.settings.sample_begin, 2);
+    return plan;
+  };
+  EXPECT_EQ(resumed_groups(2, "part.exr").scene.settings.mis_lane_groups, 2);
+  const ResumePlan old = resumed_groups(0, "before-groups.exr");
+  EXPECT_EQ(old.scene.settings.mis_lane_groups, 1);
+  // The samples it adds are a one-group render's.
+  Scene one = load_scene(scene_path);
+  one.settings.mis_lane_groups = 1;
+  one.settings.sample_begin = 2;
+  one.settings.sample_end = 4;
+  const auto added = render(old.scene);
+  EXPECT_EQ(added.info.mis_lane_groups, 1);
+  EXPECT_TRUE(testing::same_bits(added, render(one)));
+  // Shards of different groups are not merged.
+  part.info.mis_lane_groups = 2;
+  try {
+    merge_shards({part, added});
+    ADD_FAILURE() << "shards of 2 and 1 lane groups merged";
+  } catch (const spectral::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lane groups"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -211,6 +211,27 @@ TEST_F(SpectralExr, SeedKeepsAllSixtyFourBits) {
       << read_error(bad);
 }
 
+// prizma:misLaneGroups: written when set (spectral MIS's paths per sample), read back; absent is 0;
+// a value no render writes is refused with the attribute's name.
+TEST_F(SpectralExr, MisLaneGroupsRoundTripAndBadValuesAreRefused) {
+  SpectralImage img = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"});
+  const fs::path none = file("groups-none.exr");
+  write_spectral_exr(none, img);
+  EXPECT_EQ(read_spectral_exr(none).info.mis_lane_groups, 0);
+  img.info.mis_lane_groups = 3;
+  const fs::path p = file("groups.exr");
+  write_spectral_exr(p, img);
+  EXPECT_EQ(read_spectral_exr(p).info.mis_lane_groups, 3);
+  for (const int bad : {-1, 1025}) {
+    const fs::path q = rewrite_header(p, file("groups-bad.exr"), [bad](Imf::Header& h) {
+      h.insert("prizma:misLaneGroups", Imf::IntAttribute(bad));
+    });
+    EXPECT_NE(read_error(q).find("prizma:misLaneGroups: " + std::to_string(bad) + " is not a lane group count"),
+              std::string::npos)
+        << read_error(q);
+  }
+}
+
 // Compression (docs/spectral-exr.md): at most 1 MiB of pixel data (all channels as stored) is
 // written uncompressed, in the calling thread (OpenEXR's pool is not started for it); one byte more,
 // PIZ. Both read back exactly. One light, 13 bins and R, G, B: 16 floats, 64 bytes per pixel.

@@ -108,6 +108,7 @@ void put_attributes(Imf::Header& header, const SpectralImage& image, const std::
   if (!info.wavelength_sampling.empty()) {
     header.insert(kAttrWavelengthSampling, Imf::StringAttribute(info.wavelength_sampling));
   }
+  if (info.mis_lane_groups > 0) header.insert(kAttrMisLaneGroups, Imf::IntAttribute(info.mis_lane_groups));
   if (!info.scene_path.empty()) header.insert(kAttrScenePath, Imf::StringAttribute(info.scene_path));
   if (!info.render_options.empty()) header.insert(kAttrRenderOptions, Imf::StringAttribute(info.render_options));
   if (!info.denoised.empty()) header.insert(kAttrDenoised, Imf::StringAttribute(info.denoised));
@@ -129,6 +130,11 @@ SpectralExrInfo read_attributes(const Imf::Header& header, const std::string& pa
   if (const auto* s = find_string_attr(header, kAttrDenoised)) info.denoised = *s;
   info.samples = int_attr(header, kAttrSamples, p);
   info.seed = read_seed(header, kAttrSeed, p);
+  const std::int64_t groups = int_attr(header, kAttrMisLaneGroups, p);
+  if (groups < 0 || groups > BinLayout::kMaxBins)
+    throw InputError(p, std::string(kAttrMisLaneGroups) + ": " + std::to_string(groups) + " is not a lane group count (1 to " +
+                            std::to_string(BinLayout::kMaxBins) + ")");
+  info.mis_lane_groups = static_cast<int>(groups);
   return info;
 }
 

@@ -28,6 +28,7 @@ inline constexpr const char* kAttrSeed = "prizma:seed";
 inline constexpr const char* kAttrSceneHash = "prizma:sceneHash";
 inline constexpr const char* kAttrVersion = "prizma:version";
 inline constexpr const char* kAttrWavelengthSampling = "prizma:wavelengthSampling";
+inline constexpr const char* kAttrMisLaneGroups = "prizma:misLaneGroups";
 inline constexpr const char* kAttrChecksum = "prizma:checksum";
 inline constexpr const char* kAttrScenePath = "prizma:scenePath";
 inline constexpr const char* kAttrRenderOptions = "prizma:renderOptions";

@@ -24,6 +24,9 @@ struct SpectralExrInfo {
   std::string scene_hash;        // prizma:sceneHash
   std::string version;           // prizma:version
   std::string wavelength_sampling;  // prizma:wavelengthSampling
+  // prizma:misLaneGroups: spectral MIS's lane groups (paths per sample) the samples were traced with;
+  // 0: not recorded (a file without spectral MIS, or written before lane groups: one group).
+  int mis_lane_groups = 0;
   std::string scene_path;        // prizma:scenePath, the scene file (absolute) the render read
   std::string render_options;    // prizma:renderOptions (JSON object: the command-line overrides)
   // prizma:denoised (JSON object: method, parameters, guides, variance, version; docs/denoise.md), or
