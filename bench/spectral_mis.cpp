@@ -30,7 +30,6 @@
 #include "bench_common.h"
 #include "bench_image.h"
 #include "prizma/render/render.h"
-#include "prizma/render/wavelength_map.h"
 #include "prizma/spectral/error.h"
 
 namespace pb = prizma::bench;
@@ -93,7 +92,6 @@ int main(int argc, char** argv) {
   std::vector<std::string> methods{"spectral-tracking", "spectral-mis"};
   std::int64_t spp = 64;
   int size = 32, repeats = 3, threads = 2, per_bin = 0;
-  std::vector<int> groups;
   CLI::App app{"Spectral MIS against spectral tracking, and chromatic against grey, by efficiency"};
   app.add_option("--scenes", scenes, "bench scenes: grey, cube, peer, a data/scenes/NAME, NAME-grey");
   app.add_option("--methods", methods,
@@ -108,20 +106,14 @@ int main(int argc, char** argv) {
                  "grey medium alone (0: none) and split chromatic ÷ grey into the estimator's factor and the "
                  "scene's own")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--groups", groups,
-                 "also render, for each chromatic scene with its grey version in --scenes, its bins split into G "
-                 "runs of neighbouring bins, each run under spectral MIS by itself (one path per run and camera "
-                 "sample), for each G given")
-      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
 
-  std::map<std::string, std::map<std::string, std::vector<double>>> eff, relvar, cpu, coll;
+  // paths: paths per camera sample (the lane groups' paths: RenderStats::paths over the samples).
+  std::map<std::string, std::map<std::string, std::vector<double>>> eff, relvar, cpu, coll, paths;
   // --per-bin: per chromatic scene, per repeat, the lanes traced alone: the relative variance over
   // the rendered bins (Σ var / Σ mean²) and the mean CPU seconds of one bin's render.
   std::map<std::string, std::vector<double>> alone_relvar, alone_cpu, alone_coll;
   std::map<std::string, int> alone_bins;
-  // --groups: per chromatic scene and G, per repeat, the same for the G runs of bins together.
-  std::map<std::string, std::map<int, std::vector<double>>> group_relvar, group_cpu;
   std::map<std::string, pr::Scene> loaded;
   try {
     for (const std::string& name : scenes) {
@@ -162,6 +154,7 @@ int main(int argc, char** argv) {
           const double c = cpu_seconds() - c0, v = relative_variance(img);
           cpu[name][m].push_back(c);
           coll[name][m].push_back(collisions_per_path(st));
+          paths[name][m].push_back(static_cast<double>(st.paths) / (static_cast<double>(size) * size * spp));
           relvar[name][m].push_back(v);
           eff[name][m].push_back(v > 0.0 && c > 0.0 ? 1.0 / (v * c) : 0.0);
         }
@@ -189,33 +182,6 @@ int main(int argc, char** argv) {
         alone_cpu[name].push_back(c_sum / bins);
         alone_coll[name].push_back(coll_sum / bins);
       }
-      // The bins in G runs, each its own spectral-MIS render: one path per run and camera sample.
-      for (auto& [name, scene] : loaded) {
-        if (!loaded.count(grey_partner(name))) continue;
-        const std::vector<double>& edges = scene.settings.bins.edges_nm();
-        const int n = scene.settings.bins.size();
-        for (const int g : groups) {
-          if (g > n) continue;
-          VarianceSums sums;
-          double c_sum = 0.0;
-          for (int k = 0; k < g; ++k) {
-            pr::Scene s = scene;
-            const int lo = pr::WavelengthMap::run_begin(k, n, g), hi = pr::WavelengthMap::run_begin(k + 1, n, g);
-            s.settings.bins = ps::BinLayout::from_edges({edges.begin() + lo, edges.begin() + hi + 1});
-            s.settings.wavelength_sampling = pr::WavelengthSampling::SpectralMis;
-            s.settings.mis_lane_groups = 1;
-            s.settings.seed = static_cast<std::uint64_t>(r + 1);
-            const double c0 = cpu_seconds();
-            const ps::SpectralImage img = pr::render(s);
-            c_sum += cpu_seconds() - c0;
-            const VarianceSums v = variance_sums(img);
-            sums.var += v.var;
-            sums.sq += v.sq;
-          }
-          group_relvar[name][g].push_back(sums.relative());
-          group_cpu[name][g].push_back(c_sum);
-        }
-      }
     }
   } catch (const ps::InputError& e) {
     std::cerr << "bench_spectral_mis: error: " << e.what() << "\n";
@@ -241,15 +207,22 @@ int main(int argc, char** argv) {
     if (!eff.count(grey)) continue;
     // A grey medium is one lane whatever the method: its first method's renders stand for all.
     const auto& [gm, ge] = *eff.at(grey).begin();
-    for (const auto& [m, e] : per)
+    const double vg = median(relvar.at(grey).at(gm)), cg = median(cpu.at(grey).at(gm));
+    const double pg = median(paths.at(grey).at(gm));
+    for (const auto& [m, e] : per) {
+      // The cost split per path (a sample traces one path per lane group): the relative variance
+      // of one path's estimate (the mean's × the paths per sample) and the CPU seconds of one path,
+      // each against the grey version's.
+      const double pm = median(paths.at(name).at(m));
       std::cout << name << " (" << m << ") ÷ " << grey << " (" << gm << ") cost at equal error: "
-                << median(ge) / median(e) << "×\n";
+                << median(ge) / median(e) << "×; per path: variance " << median(relvar.at(name).at(m)) * pm / (vg * pg)
+                << "× · CPU " << median(cpu.at(name).at(m)) / pm / (cg / pg) << "× (" << pm << " paths per sample)\n";
+    }
     if (!alone_relvar.count(name)) continue;
     // cost ratio = (CPU ratio)·(variance ratio), split at the lanes traced alone: the estimator's
     // factor (sharing one path among the lanes, and their arithmetic) times the scene's own (what
     // the grey estimator itself pays at each bin's coefficients against the bin average's).
     const double va = median(alone_relvar.at(name)), ca = median(alone_cpu.at(name));
-    const double vg = median(relvar.at(grey).at(gm)), cg = median(cpu.at(grey).at(gm));
     std::cout << "  " << name << "'s lanes traced alone (" << alone_bins.at(name)
               << " bins, each its grey medium): rel. variance " << va << ", CPU " << ca << " s per bin, collisions per path "
               << median(alone_coll.at(name)) << "\n";
@@ -259,17 +232,6 @@ int main(int argc, char** argv) {
       const double vm = median(relvar.at(name).at(m)), cm = median(cpu.at(name).at(m));
       std::cout << "  estimator factor (" << m << " ÷ alone): CPU " << cm / ca << "× · variance " << vm / va
                 << "× = " << cm * vm / (ca * va) << "×\n";
-    }
-  }
-  // --groups: the G runs' summed CPU and pooled variance, against the grey version's one path.
-  for (const auto& [name, per_g] : group_relvar) {
-    const std::string grey = grey_partner(name);
-    const auto& [gm, ge] = *eff.at(grey).begin();
-    const double vg = median(relvar.at(grey).at(gm)), cg = median(cpu.at(grey).at(gm));
-    for (const auto& [g, v] : per_g) {
-      const double vr = median(v), cr = median(group_cpu.at(name).at(g));
-      std::cout << name << " in " << g << " runs of bins (spectral-mis each) ÷ " << grey << ": CPU " << cr / cg
-                << "× · variance " << vr / vg << "× = " << cr * vr / (cg * vg) << "× cost at equal error\n";
     }
   }
   std::cout << "load at end " << pb::load_average() << "\n";

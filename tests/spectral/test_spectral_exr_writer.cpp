@@ -212,7 +212,7 @@ TEST_F(SpectralExr, SeedKeepsAllSixtyFourBits) {
 }
 
 // prizma:misLaneGroups: written when set (spectral MIS's paths per sample), read back; absent is 0;
-// a value no render writes is refused with the attribute's name.
+// a value no render writes is refused with the attribute's name, by the reader and by the writer.
 TEST_F(SpectralExr, MisLaneGroupsRoundTripAndBadValuesAreRefused) {
   SpectralImage img = make_image(2, 2, BinLayout::linear(400, 700, 3), {"a"});
   const fs::path none = file("groups-none.exr");
@@ -229,6 +229,14 @@ TEST_F(SpectralExr, MisLaneGroupsRoundTripAndBadValuesAreRefused) {
     EXPECT_NE(read_error(q).find("prizma:misLaneGroups: " + std::to_string(bad) + " is not a lane group count"),
               std::string::npos)
         << read_error(q);
+    img.info.mis_lane_groups = bad;
+    try {
+      write_spectral_exr(file("groups-bad-written.exr"), img);
+      ADD_FAILURE() << "wrote prizma:misLaneGroups " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is not a lane group count"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(file("groups-bad-written.exr")));
   }
 }
 

@@ -80,6 +80,13 @@ std::uint64_t read_seed(const Imf::Header& h, const char* name, const std::strin
 
 }  // namespace
 
+// prizma:misLaneGroups: 0 (not recorded) or a lane group count no render exceeds (one per bin).
+void check_mis_lane_groups(std::int64_t groups, const std::string& path) {
+  if (groups < 0 || groups > BinLayout::kMaxBins)
+    throw InputError(path, std::string(kAttrMisLaneGroups) + ": " + std::to_string(groups) +
+                               " is not a lane group count (1 to " + std::to_string(BinLayout::kMaxBins) + ")");
+}
+
 void put_attributes(Imf::Header& header, const SpectralImage& image, const std::string& path) {
   const std::string& p = path;
   header.insert("spectralLayoutVersion", Imf::StringAttribute(kLayoutVersion));
@@ -98,6 +105,7 @@ void put_attributes(Imf::Header& header, const SpectralImage& image, const std::
   }
   const SpectralExrInfo& info = image.info;
   check_light_records(info.light_records, layer_names(image), p);
+  check_mis_lane_groups(info.mis_lane_groups, p);
   header.insert(kAttrLights, Imf::StringAttribute(light_records_json(
                                  info.light_records.empty() ? light_records_for(layer_names(image)) : info.light_records)));
   put_int_or_string(header, kAttrSamples, info.samples);
@@ -131,9 +139,7 @@ SpectralExrInfo read_attributes(const Imf::Header& header, const std::string& pa
   info.samples = int_attr(header, kAttrSamples, p);
   info.seed = read_seed(header, kAttrSeed, p);
   const std::int64_t groups = int_attr(header, kAttrMisLaneGroups, p);
-  if (groups < 0 || groups > BinLayout::kMaxBins)
-    throw InputError(p, std::string(kAttrMisLaneGroups) + ": " + std::to_string(groups) + " is not a lane group count (1 to " +
-                            std::to_string(BinLayout::kMaxBins) + ")");
+  check_mis_lane_groups(groups, p);
   info.mis_lane_groups = static_cast<int>(groups);
   return info;
 }
