@@ -30,6 +30,8 @@ evt() {  # tag, VAR=value: the error-vs-time renders of $SCENES × $METHODS with
     --scenes $SCENES --methods $METHODS --out "$OUT/$tag.csv" > "$OUT/$tag.txt" 2>&1
 }
 {
+  # (sharing.txt beside this script was re-run with main's bench_spectral_mis at 3305bf1, which prints
+  # the split per path; the patched build's gives the same variances)
   log "paths per sample against sharing: bench_spectral_mis, G = 1 2 3 6 12"
   $B/bench_spectral_mis --scenes grey cube peer peer-grey --methods spectral-mis:1 spectral-mis:2 spectral-mis:3 \
     spectral-mis:6 spectral-mis:12 --spp 64 --size 64 --repeats 3 --threads 2 > "$OUT/sharing.txt" 2>&1
