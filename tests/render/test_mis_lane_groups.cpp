@@ -165,7 +165,8 @@ TEST(MisLaneGroups, ARenderTracesOnePathPerGroupAndEveryBinGetsItsShare) {
 // A file records the groups its samples were traced with (prizma:misLaneGroups), and --resume and
 // merge keep to them whatever `auto` resolves to in this build: a file of spectral MIS without the
 // attribute (written before lane groups) continues with one path for all bins, the samples a
-// one-group render takes, bit for bit; shards of different groups are refused.
+// one-group render takes, bit for bit; shards of different groups are refused (such a file counts
+// as one group).
 TEST(MisLaneGroups, FilesRecordTheirGroupsAndResumeAndMergeKeepThem) {
   const testing::ScratchDir dir;
   // tests/e2e/render/tiny.json's medium: Gaussian extinction over 6 bins, 2 groups under auto.
@@ -206,7 +207,9 @@ TEST(MisLaneGroups, FilesRecordTheirGroupsAndResumeAndMergeKeepThem) {
   const auto added = render(old.scene);
   EXPECT_EQ(added.info.mis_lane_groups, 1);
   EXPECT_TRUE(testing::same_bits(added, render(one)));
-  // Shards of different groups are not merged.
+  // Shards of different groups are not merged; a file without the attribute is one group.
+  part.info.mis_lane_groups = 0;
+  EXPECT_EQ(merge_shards({part, added}).info.sample_range, "0:4");
   part.info.mis_lane_groups = 2;
   try {
     merge_shards({part, added});

@@ -78,14 +78,14 @@ std::uint64_t read_seed(const Imf::Header& h, const char* name, const std::strin
   throw InputError(path, std::string(name) + ": \"" + *s + "\" is not a 64-bit seed");
 }
 
-}  // namespace
-
 // prizma:misLaneGroups: 0 (not recorded) or a lane group count no render exceeds (one per bin).
 void check_mis_lane_groups(std::int64_t groups, const std::string& path) {
   if (groups < 0 || groups > BinLayout::kMaxBins)
     throw InputError(path, std::string(kAttrMisLaneGroups) + ": " + std::to_string(groups) +
                                " is not a lane group count (1 to " + std::to_string(BinLayout::kMaxBins) + ")");
 }
+
+}  // namespace
 
 void put_attributes(Imf::Header& header, const SpectralImage& image, const std::string& path) {
   const std::string& p = path;
