@@ -53,16 +53,12 @@ bool is_out_of_memory(const std::exception& e) {
 }
 
 bool message_says_out_of_memory(std::string_view what) {
-  std::string unquoted;
-  unquoted.reserve(what.size());
-  bool quoted = false;
-  for (const char ch : what) {
-    if (ch == '"') {
-      quoted = !quoted;
-    } else if (!quoted) {
-      unquoted += ch;
-    }
-  }
+  // Only the text before the first quote and after the last: names from a file (its path, its
+  // channels) are quoted and may hold quotes themselves (a channel `a"Out of memory`), so pairing
+  // the quotes one by one can put a file's text outside them. Nothing after a lone quote.
+  const std::size_t first = what.find('"'), last = what.rfind('"');
+  std::string unquoted(what.substr(0, first));
+  if (first != std::string_view::npos && last != first) unquoted += what.substr(last + 1);
   for (const std::string_view marker :
        {"ut of memory", "bad_alloc", "Cannot allocate memory", "Resource temporarily unavailable"}) {
     if (unquoted.find(marker) != std::string::npos) return true;

@@ -22,6 +22,13 @@ TEST(ToolMain, QuotedFileTextIsNotOutOfMemory) {
   EXPECT_FALSE(message_says_out_of_memory("Unexpected end of file."));
   // An unbalanced quote hides the rest: the message is then not taken as out of memory.
   EXPECT_FALSE(message_says_out_of_memory("channel \"std::bad_alloc"));
+  // The fuzzer's input (tests/fuzz/corpus/spectral_exr/regression-quote-in-channel-name): a quote
+  // inside a channel's name, pairing quotes one by one would leave "ut of memory" outside them.
+  EXPECT_FALSE(message_says_out_of_memory(
+      "Cannot read image file \"/tmp/input.exr\". Number of pixels per row in the image's data window is not a "
+      "multiple of the x subsampling factor of the \"a[{\"fut of memoryEEEE\" channel."));
+  // Text after the last quote still counts.
+  EXPECT_TRUE(message_says_out_of_memory("Cannot read \"a\"b\" channel: std::bad_alloc"));
 }
 
 }  // namespace

@@ -21,8 +21,8 @@ bool is_out_of_resources(const std::system_error& e);
 bool is_out_of_memory(const std::exception& e);
 // True when a library's error message (OpenEXR's Iex, OCIO) says that memory or threads ran out:
 // "Out of memory", "std::bad_alloc", "Cannot allocate memory", "Resource temporarily unavailable".
-// Text in double quotes is ignored: those messages quote file names and channel names, which come
-// from the input and may contain these very words (a channel named "Cannot allocate memory").
+// Text from the first to the last double quote is ignored: the messages quote file and channel names,
+// which come from the input and may hold these words and quotes (channels "Out of memory", a"bad_alloc).
 bool message_says_out_of_memory(std::string_view what);
 
 // Runs f(); running out of memory inside it (std::bad_alloc, or a thread that cannot be started)
