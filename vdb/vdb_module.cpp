@@ -2,6 +2,8 @@
 // renderer/include/prizma/render/vdb_module.h. One float grid, densified over the bounding box of its
 // active voxels for the tracer's lookups, with the majorant's per-block value ranges taken from the
 // tree's leaf nodes and tiles, so that the empty space between them is never visited.
+#include <openvdb/io/Archive.h>
+#include <openvdb/io/GridDescriptor.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 #include <sys/resource.h>
@@ -214,6 +216,55 @@ class LibraryLogCapture {
   std::streambuf* m_err;
 };
 
+// OpenVDB 10 reads a size from the file into a variable it has not initialised and goes on with it
+// when the read ran into the end of the file (io::bloscFromStream, the string reader): a file cut
+// short then asks for whatever that variable held, a few bytes or terabytes (AddressSanitizer aborts
+// on it), and its error changed from run to run (1 in ~30 under AddressSanitizer). So before
+// io::File reads a file, its layout is walked as io::File::open walks it, with the library's own
+// readers (the header, the file's metadata, each grid's descriptor) on a stream that throws at the
+// file's end, and every grid must end inside the file. A file that passes holds every byte its
+// grids announce; one that fails is named cut short, with the byte where it ends.
+class LayoutCheck : private openvdb::io::Archive {
+ public:
+  static void run(const char* path) { LayoutCheck().walk(path); }
+
+ private:
+  void walk(const char* path) {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    if (!in) return;  // io::File says what is wrong with opening it
+    const std::int64_t file_bytes = in.tellg();
+    in.seekg(0);
+    const std::string end = std::to_string(file_bytes);
+    const auto refuse = [](const std::string& why) {
+      throw Failure{PRIZMA_VDB_BAD_FILE, "not a readable OpenVDB file (" + why + ")"};
+    };
+    if (file_bytes == 0) refuse("the file is empty");
+    in.exceptions(std::ios::failbit | std::ios::badbit | std::ios::eofbit);
+    LibraryLogCapture unheard;  // what the library notices here, io::File::open notices again, heard
+    try {
+      readHeader(in);
+      if (!inputHasGridOffsets()) return;  // written as a stream: io::File reads it whole, in order
+      setFormatVersion(in);
+      setLibraryVersion(in);
+      setDataCompression(in);
+      openvdb::MetaMap().readMeta(in);
+      for (std::int32_t i = 0, n = readGridCount(in); i < n; ++i) {
+        openvdb::io::GridDescriptor grid;
+        grid.read(in);
+        const std::string name = "grid \"" + grid.gridName() + "\"";
+        if (grid.getGridPos() < 0 || grid.getEndPos() < grid.getGridPos())
+          refuse("corrupt: " + name + " at bytes " + std::to_string(grid.getGridPos()) + " to " +
+                 std::to_string(grid.getEndPos()));
+        if (grid.getEndPos() > file_bytes)
+          refuse("cut short: " + name + " ends at byte " + std::to_string(grid.getEndPos()) + ", the file at byte " + end);
+        grid.seekToEnd(in);
+      }
+    } catch (const std::ios_base::failure&) {
+      refuse("cut short: the file ends at byte " + end + ", inside its header or a grid's descriptor");
+    }
+  }
+};
+
 // Floor division for block indices of voxels that may lie one voxel outside the box.
 int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
@@ -256,14 +307,14 @@ int open_grid(const char* path, const char* grid_name, PrizmaVdbGrid** out, Priz
     openvdb::GridBase::Ptr base;
     LibraryLogCapture log;
     const ReadMemoryBound bound(path);
+    LayoutCheck::run(path);
     openvdb::io::File file(path);
     file.open(false);  // no delayed loading: the file is read now, not behind our back later
     if (!file.hasGrid(grid_name)) {
       const std::string names = grid_names(file);
       file.close();
-      // OpenVDB reads a header cut short as a file of no grids.
       throw Failure{PRIZMA_VDB_BAD_FILE, "no grid named \"" + std::string(grid_name) + "\" (" +
-                                             (names.empty() ? std::string("the file holds no grids: empty, or cut short")
+                                             (names.empty() ? std::string("the file holds no grids")
                                                             : "grids in the file: " + names) + ")"};
     }
     base = file.readGrid(grid_name);

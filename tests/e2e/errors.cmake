@@ -136,8 +136,10 @@ if(TARGET prizma-render)
       prizma_render_error(${name} ${name}.json "${input}" "${reason}")
       set_tests_properties(errors.e2e.render_${name} PROPERTIES FIXTURES_REQUIRED "errors_files;errors_vdb_files")
     endfunction()
-    prizma_vdb_error(vdb_truncated "vdb_truncated\\.vdb" "not a readable OpenVDB file \\(.*Expected to")
-    prizma_vdb_error(vdb_truncated_header "vdb_truncated_header\\.vdb" "no grid named \"density\" \\(the file holds no grids: empty, or cut short\\)")
+    prizma_vdb_error(vdb_truncated "vdb_truncated\\.vdb"
+                     "not a readable OpenVDB file \\(cut short: grid \"density\" ends at byte 42125, the file at byte 21062\\)")
+    prizma_vdb_error(vdb_truncated_header "vdb_truncated_header\\.vdb"
+                     "not a readable OpenVDB file \\(cut short: the file ends at byte 40, inside its header or a grid's descriptor\\)")
     if(NOT PRIZMA_SANITIZE AND NOT PRIZMA_FUZZ)  # AddressSanitizer aborts on the size before OpenVDB can throw
       prizma_vdb_error(vdb_flipped_size "vdb_flipped_size\\.vdb"
                        "not a readable OpenVDB file \\(corrupt: a size in it asks for more memory than any valid file of 42125 bytes needs\\)")
