@@ -33,13 +33,6 @@ std::string merged_options(const std::vector<spectral::SpectralImage>& shards,
   return common.dump();
 }
 
-// The lane groups a shard's samples were traced with: prizma:misLaneGroups, and one for a spectral-MIS
-// file without it (written before lane groups); 0 for the other estimators.
-int lane_groups(const spectral::SpectralExrInfo& info) {
-  if (info.wavelength_sampling != wavelength_sampling_name(WavelengthSampling::SpectralMis)) return info.mis_lane_groups;
-  return std::max(1, info.mis_lane_groups);
-}
-
 }  // namespace
 
 std::vector<spectral::LightRecord> light_records(const std::vector<Light>& lights) {
@@ -146,7 +139,7 @@ spectral::SpectralImage merge_shards(const std::vector<spectral::SpectralImage>&
     if (s.info.scene_hash != first.info.scene_hash) refuse("scene hash");
     if (s.info.seed != first.info.seed) refuse("seed");
     if (s.info.wavelength_sampling != first.info.wavelength_sampling) refuse("wavelength sampling");
-    if (lane_groups(s.info) != lane_groups(first.info)) refuse("spectral MIS's lane groups (prizma:misLaneGroups)");
+    if (recorded_mis_lane_groups(s.info) != recorded_mis_lane_groups(first.info)) refuse("spectral MIS's lane groups (prizma:misLaneGroups)");
     if (s.info.light_records != first.info.light_records || s.lights.size() != first.lights.size()) refuse("lights");
     for (std::size_t l = 0; l < s.lights.size(); ++l)
       if (s.lights[l].name != first.lights[l].name) refuse("lights");

@@ -377,6 +377,8 @@ int resolve_mis_lane_groups(const Scene& scene) {
   return most;
 }
 
+int recorded_mis_lane_groups(const spectral::SpectralExrInfo& info) { return std::max(1, info.mis_lane_groups); }
+
 std::string sampler_name(Sampler s) { return s == Sampler::Sobol ? "sobol" : "independent"; }
 
 Sampler parse_sampler(std::string_view name, std::string_view input) {

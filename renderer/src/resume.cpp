@@ -164,10 +164,9 @@ ResumePlan plan_resume(const ResumeRequest& req) {
   // (auto resolves by the scene; a file of an earlier version holds spectral tracking's samples).
   if (!info.wavelength_sampling.empty())
     plan.scene.settings.wavelength_sampling = parse_wavelength_sampling(info.wavelength_sampling, file + ": prizma:wavelengthSampling");
-  // Likewise spectral MIS's lane groups: a file of spectral MIS without prizma:misLaneGroups was
-  // traced with one path for all bins (before lane groups), whatever `auto` resolves to now.
+  // Likewise spectral MIS's lane groups, whatever `auto` resolves to now.
   if (plan.scene.settings.wavelength_sampling == WavelengthSampling::SpectralMis)
-    plan.scene.settings.mis_lane_groups = std::max(1, info.mis_lane_groups);
+    plan.scene.settings.mis_lane_groups = recorded_mis_lane_groups(info);
   if (!plan.previous.lights.empty() && !plan.previous.lights.front().variance.empty())
     plan.scene.settings.write_variance = true;
   if (!plan.previous.guides.empty()) plan.scene.settings.write_guides = true;

@@ -118,5 +118,9 @@ WavelengthSampling resolve_wavelength_sampling(const Scene& scene);
 inline constexpr double kMisGroupExtinctionRatio = 2.5;
 inline constexpr int kMisGroupMinBins = 3;
 int resolve_mis_lane_groups(const Scene& scene);
+// The lane groups a file's samples were traced with if spectral MIS traced them (what --resume
+// continues with; merge_shards compares it after the estimator): prizma:misLaneGroups, and 1 where it
+// is absent (a file written before lane groups: one path for all bins).
+int recorded_mis_lane_groups(const spectral::SpectralExrInfo& info);
 
 }  // namespace prizma::render
