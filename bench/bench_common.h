@@ -168,6 +168,10 @@ inline spectral::SpectralImage cached_render(const render::Scene& scene, const f
   // A render with guide layers is another file (bench_denoise_error --features denoises the cached bias
   // render with them: one cached without would silently be denoised on the luminance alone).
   if (st.write_guides) key << "|guides";  // older keys unchanged
+  // Spectral MIS's lane groups as resolved (auto became 3 groups on the cube and bench_peer): other bits,
+  // and 1.9-3.7x less variance per sample, which bench_denoise_error's reference-noise floor assumes
+  // the reference shares with the raw renders.
+  if (const int groups = render::resolve_mis_lane_groups(scene); groups > 1) key << "|groups" << groups;  // older keys unchanged
   for (const auto& l : scene.lights) key << '|' << l.name << ':' << l.spectrum_spec;
   const fs::path file = cache_dir / (tag + "-" + hash_hex(key.str()) + ".exr");
   if (fs::exists(file)) {
