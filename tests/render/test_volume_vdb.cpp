@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -330,6 +332,29 @@ TEST(VdbVolume, FilesCutShortAreInputErrorsSayingSo) {
   // The header and the grid's descriptor take the first ~200 bytes; the grid itself the rest.
   EXPECT_GT(in_header, 100);
   EXPECT_GT(in_grid, 16);
+}
+
+// The grid's descriptor holds its start and end positions (8 bytes, little-endian, 42125 in cloud.vdb): one
+// before its start is refused as corrupt, one past the file's end as cut short, naming the grid.
+TEST(VdbVolume, GridPositionsOutsideTheFileAreRefused) {
+  ScratchDir dir;
+  const std::string good = cloud_vdb_bytes();
+  const std::int64_t end = 42125;
+  const std::string end_bytes(reinterpret_cast<const char*>(&end), sizeof end);
+  const std::size_t at = good.find(end_bytes);
+  ASSERT_LT(at, 400u);  // in the descriptor, before the grid's data
+  const auto with_end = [&](std::int64_t value) {
+    std::string bytes = good;
+    bytes.replace(at, sizeof value, std::string(reinterpret_cast<const char*>(&value), sizeof value));
+    return dir.write("moved.vdb", bytes);
+  };
+  std::int64_t start = 0;  // the grid's start, two positions before its end (start, blocks, end)
+  std::memcpy(&start, good.data() + at - 2 * sizeof start, sizeof start);
+  ASSERT_GT(start, 1);
+  expect_input_error(with_end(1), "density",
+                     "not a readable OpenVDB file (corrupt: grid \"density\" at bytes " + std::to_string(start) + " to 1)");
+  expect_input_error(with_end(99999), "density",
+                     "not a readable OpenVDB file (cut short: grid \"density\" ends at byte 99999, the file at byte 42125)");
 }
 
 // issue 21: one byte changed in the leaf data of a real file asked for terabytes: "out of memory"
